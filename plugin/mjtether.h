@@ -1,0 +1,81 @@
+// mjtether: lumped-mass tethers in MuJoCo 2.2 through the mjcb_passive callback.
+//
+// Usage (see README.md):
+//   std::string error;
+//   mjModel* m = mjtether::LoadModel("rov.xml", &error);   // mj_loadXML + Attach
+//   mjData* d = mj_makeData(m);                             // sized for the tether state
+//   while (d->time < 10) mj_step(m, d);                     // the vehicle feels the tether
+//   double T = mjtether::GetReactions(m, d, 0).tension_b;
+//   mj_deleteData(d); mjtether::Detach(m); mj_deleteModel(m);
+//
+// Declarations are read from <custom><text> (see README.md for every key): one
+// "tether:NAME" text per tether, and an optional "water" text. A plain MuJoCo loader ignores
+// them, so the same file still loads without mjtether.
+//
+// State: each tether's node positions and velocities, its own time and the ends' motion at
+// that time live in mjData::userdata (Attach raises nuserdata before mj_makeData), so
+// mj_copyData, mj_resetData and rollouts carry them. Scratch memory comes from mjData's stack
+// (Attach raises nstack), so the callback allocates nothing and is thread-safe for distinct
+// mjData.
+#ifndef MJTETHER_PLUGIN_MJTETHER_H_
+#define MJTETHER_PLUGIN_MJTETHER_H_
+
+#include <optional>
+#include <string>
+
+#include <mujoco/mujoco.h>
+
+#include "tether.h"
+
+namespace mjtether {
+
+// Loads an MJCF file and attaches its tethers. Returns nullptr with *error set on failure;
+// the message names the file, the element and the key.
+mjModel* LoadModel(const std::string& path, std::string* error);
+
+// The same from MJCF text held in memory; `name` stands for the file in messages.
+mjModel* LoadModelFromString(const std::string& xml, const std::string& name,
+                             std::string* error);
+
+// Reads the declarations of an already loaded model, raises m->nuserdata and m->nstack and
+// installs the passive callback (chaining to one installed before). Call before mj_makeData.
+// `source` names the file in error messages. A model without tether declarations is left
+// unchanged and returns true. Attaching the same model twice is an error.
+bool Attach(mjModel* m, const std::string& source, std::string* error);
+
+// Forgets a model (call before mj_deleteModel). Unknown models are ignored.
+void Detach(const mjModel* m);
+
+// Number of tethers attached to m, and the index of one by name (-1 if none).
+int TetherCount(const mjModel* m);
+int FindTether(const mjModel* m, const std::string& name);
+std::string TetherName(const mjModel* m, int k);
+// The engine object of tether k (parameters, masses, stability limit).
+const Tether* GetTether(const mjModel* m, int k);
+// Bodies of ends A and B (-1 for a free end).
+int EndBody(const mjModel* m, int k, int end);
+
+// Node positions of tether k in d (3 x (N+1) column-major, world frame [m]), velocities, and
+// the tether's own time [s] (the last mjcb_passive call). Null before the first call.
+const double* NodePositions(const mjModel* m, const mjData* d, int k);
+const double* NodeVelocities(const mjModel* m, const mjData* d, int k);
+double TetherTime(const mjModel* m, const mjData* d, int k);
+
+// End reactions of tether k as applied at the last callback (forces [N] on the sites,
+// moments [N m], tension magnitudes [N]).
+EndReactions GetReactions(const mjModel* m, const mjData* d, int k);
+
+// Segment tensions of tether k [N] into T (N values).
+void GetTensions(const mjModel* m, const mjData* d, int k, double* T);
+
+// If a tether in d has diverged, a message naming the tether, the time and the node, and
+// what to change; the diverged tether stops applying forces. Otherwise nullopt.
+std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d);
+
+// Replaces MuJoCo's default error handler (which waits on stdin) by one that prints the
+// message and exits with status 3, and routes warnings to stderr. Idempotent.
+void InstallErrorHandlers();
+
+}  // namespace mjtether
+
+#endif  // MJTETHER_PLUGIN_MJTETHER_H_

@@ -1,0 +1,411 @@
+// MuJoCo 2.2 glue: declarations from <custom>, state in mjData::userdata, forces through
+// mjcb_passive.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <mutex>
+#include <shared_mutex>
+#include <sstream>
+#include <unordered_map>
+#include <vector>
+
+#include "declaration.h"
+#include "mjtether.h"
+
+namespace mjtether {
+namespace {
+
+// Layout of one tether's block in mjData::userdata.
+enum Slot : int {
+  kInitialized = 0,  // 1 once the initial shape is set (mj_resetData zeroes it)
+  kTime,             // [s] the tether's own time
+  kStatus,           // 0 ok, 1 non-finite, 2 strain beyond max_strain
+  kBadNode,          // first offending node
+  kBadTime,          // [s] when it diverged
+  kEndA,             // pos(3) vel(3) axis(3) of end A at kTime
+  kEndB = kEndA + 9,  // same for end B
+  kForceA = kEndB + 9,  // last reactions: force A(3), torque A(3), force B(3), torque B(3)
+  kTensionA = kForceA + 12,
+  kTensionB,
+  kHeader,           // x (3 x n) then v (3 x n) follow
+};
+
+struct AttachedTether {
+  std::string name;
+  Tether tether;
+  int site[2] = {-1, -1};  // -1: free end
+  int body[2] = {-1, -1};
+  bool mocap[2] = {false, false};  // end on a mocap body: velocity by finite difference
+  int offset = 0;                  // start of this tether's block in userdata
+};
+
+struct ModelTethers {
+  std::string source;
+  std::vector<AttachedTether> tethers;
+  int work_size = 0;  // doubles of mjData stack the callback takes
+  int nuserdata = 0;  // m->nuserdata after Attach, to catch a stale registration
+};
+
+std::shared_mutex g_mutex;
+std::unordered_map<const mjModel*, std::unique_ptr<ModelTethers>> g_models;
+mjfGeneric g_previous_passive = nullptr;
+bool g_installed = false;
+
+void Passive(const mjModel* m, mjData* d);
+
+const ModelTethers* Lookup(const mjModel* m) {
+  std::shared_lock<std::shared_mutex> lock(g_mutex);
+  auto it = g_models.find(m);
+  if (it == g_models.end() || it->second->nuserdata != m->nuserdata) return nullptr;
+  return it->second.get();
+}
+
+const char* TextName(const mjModel* m, int i) { return m->names + m->name_textadr[i]; }
+const char* TextData(const mjModel* m, int i) { return m->text_data + m->text_adr[i]; }
+
+// Site position, velocity and x-axis now. A mocap-rooted body has no velocity in MuJoCo, so its
+// velocity is the finite difference from the stored previous position.
+EndState SiteState(const mjModel* m, const mjData* d, const AttachedTether& at, int end,
+                   const double* u) {
+  EndState e;
+  const int s = at.site[end];
+  const double* stored = u + (end == 0 ? kEndA : kEndB);
+  e.pos = Vec3(d->site_xpos + 3 * s);
+  const double* R = d->site_xmat + 9 * s;
+  e.axis = Vec3(R[0], R[3], R[6]);
+  if (at.mocap[end]) {
+    const double dt = d->time - u[kTime];
+    if (u[kInitialized] != 0 && dt > 0) {
+      e.vel = (e.pos - Vec3(stored)) / dt;
+    } else if (u[kInitialized] != 0) {
+      e.vel = Vec3(stored + 3);
+    }
+  } else {
+    mjtNum res[6];
+    mj_objectVelocity(m, d, mjOBJ_SITE, s, res, 0);
+    e.vel = Vec3(res[3], res[4], res[5]);
+  }
+  return e;
+}
+
+void StoreEnd(const EndState& e, double* dst) {
+  for (int i = 0; i < 3; ++i) {
+    dst[i] = e.pos[i];
+    dst[3 + i] = e.vel[i];
+    dst[6 + i] = e.axis[i];
+  }
+}
+
+EndState LoadEnd(const double* src) {
+  EndState e;
+  e.pos = Vec3(src);
+  e.vel = Vec3(src + 3);
+  e.axis = Vec3(src + 6);
+  return e;
+}
+
+// One tether at one callback: initialise or advance to d->time, then apply the reactions.
+void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* work) {
+  double* u = d->userdata + at.offset;
+  if (u[kStatus] != 0) return;  // diverged: stays inert until reset
+  const Tether& tether = at.tether;
+  const bool free_end = at.site[1] < 0;
+  double* x = u + kHeader;
+  double* v = x + 3 * tether.nodes();
+  Ends now;
+  now.a = SiteState(m, d, at, 0, u);
+  if (!free_end) now.b = SiteState(m, d, at, 1, u);
+
+  if (u[kInitialized] == 0 || d->time < u[kTime]) {
+    // First call, reset, or time went back: start again from the declared initial shape.
+    tether.InitialShape(now, x, v);
+    u[kInitialized] = 1;
+    u[kTime] = d->time;
+    StoreEnd(now.a, u + kEndA);
+    StoreEnd(now.b, u + kEndB);
+  } else if (d->time > u[kTime]) {
+    Ends from{LoadEnd(u + kEndA), LoadEnd(u + kEndB)};
+    StepStatus status = tether.Advance(x, v, from, now, d->time - u[kTime], work);
+    if (!status.ok) {
+      u[kStatus] = status.reason.rfind("strain", 0) == 0 ? 2 : 1;
+      u[kBadNode] = status.node;
+      u[kBadTime] = d->time;
+      return;
+    }
+    u[kTime] = d->time;
+    StoreEnd(now.a, u + kEndA);
+    StoreEnd(now.b, u + kEndB);
+  }
+
+  // Reactions from the state and the sites as they are at this call.
+  EndReactions r = tether.Reactions(x, v, now, work);
+  double* cache = u + kForceA;
+  for (int i = 0; i < 3; ++i) {
+    cache[i] = r.force_a[i];
+    cache[3 + i] = r.torque_a[i];
+    cache[6 + i] = r.force_b[i];
+    cache[9 + i] = r.torque_b[i];
+  }
+  u[kTensionA] = r.tension_a;
+  u[kTensionB] = r.tension_b;
+  if (at.body[0] > 0 && !at.mocap[0]) {
+    mj_applyFT(m, d, r.force_a.data(), r.torque_a.data(), d->site_xpos + 3 * at.site[0],
+               at.body[0], d->qfrc_passive);
+  }
+  if (!free_end && at.body[1] > 0 && !at.mocap[1]) {
+    mj_applyFT(m, d, r.force_b.data(), r.torque_b.data(), d->site_xpos + 3 * at.site[1],
+               at.body[1], d->qfrc_passive);
+  }
+}
+
+void Passive(const mjModel* m, mjData* d) {
+  if (g_previous_passive) g_previous_passive(m, d);
+  const ModelTethers* set = Lookup(m);
+  if (!set) return;
+  mjMARKSTACK;
+  double* work = mj_stackAlloc(d, set->work_size);
+  for (const AttachedTether& at : set->tethers) Evaluate(m, d, at, work);
+  mjFREESTACK;
+}
+
+void DefaultError(const char* message) {
+  std::fprintf(stderr, "mjtether: MuJoCo error: %s\n", message);
+  std::exit(3);
+}
+
+void DefaultWarning(const char* message) {
+  std::fprintf(stderr, "mjtether: MuJoCo warning: %s\n", message);
+}
+
+const double* UserBlock(const mjModel* m, const mjData* d, int k) {
+  const ModelTethers* set = Lookup(m);
+  if (!set || k < 0 || k >= static_cast<int>(set->tethers.size())) return nullptr;
+  return d->userdata + set->tethers[k].offset;
+}
+
+}  // namespace
+
+void InstallErrorHandlers() {
+  mju_user_error = DefaultError;
+  mju_user_warning = DefaultWarning;
+}
+
+bool Attach(mjModel* m, const std::string& source, std::string* error) {
+  auto fail = [&](const std::string& element, const std::string& message) {
+    if (error) *error = source + ": <text name=\"" + element + "\">: " + message;
+    return false;
+  };
+  if (!mju_user_error) mju_user_error = DefaultError;
+  {
+    std::shared_lock<std::shared_mutex> lock(g_mutex);
+    if (g_models.count(m)) return fail("", "this model is already attached");
+  }
+  // The environment: gravity from <option>, water from <text name="water">.
+  Environment env;
+  env.gravity = (m->opt.disableflags & mjDSBL_GRAVITY) ? Vec3::Zero() : Vec3(m->opt.gravity);
+  for (int i = 0; i < m->ntext; ++i) {
+    if (std::strcmp(TextName(m, i), "water") != 0) continue;
+    DeclarationError e;
+    std::optional<Water> water = ParseWater(TextData(m, i), &e);
+    if (!water) return fail("water", e.message);
+    env.wet = true;
+    env.water = *water;
+  }
+
+  auto set = std::make_unique<ModelTethers>();
+  set->source = source;
+  int offset = m->nuserdata;
+  for (int i = 0; i < m->ntext; ++i) {
+    const std::string name = TextName(m, i);
+    if (name.rfind("tether:", 0) != 0) continue;
+    DeclarationError e;
+    std::optional<TetherDeclaration> decl = ParseTether(TextData(m, i), env, &e);
+    if (!decl) return fail(name, e.message);
+    if (name.size() == 7) return fail(name, "a tether needs a name after 'tether:'");
+    std::string message;
+    std::optional<Tether> tether = Tether::Create(decl->params, env, &message);
+    if (!tether) return fail(name, message);
+    AttachedTether at{name.substr(7), *tether};
+    const std::string sites[2] = {decl->site_a, decl->site_b};
+    for (int end = 0; end < 2; ++end) {
+      if (sites[end].empty()) continue;  // free end B
+      at.site[end] = mj_name2id(m, mjOBJ_SITE, sites[end].c_str());
+      if (at.site[end] < 0) {
+        return fail(name, "key 'ends': no site named '" + sites[end] + "' in the model");
+      }
+      at.body[end] = m->site_bodyid[at.site[end]];
+      at.mocap[end] = m->body_mocapid[m->body_rootid[at.body[end]]] >= 0;
+    }
+    const long long block = kHeader + static_cast<long long>(tether->StateSize());
+    if (offset + block > 1'000'000'000LL) {
+      return fail(name, "the tethers need more than 1e9 doubles of state: fewer segments");
+    }
+    at.offset = offset;
+    offset += static_cast<int>(block);
+    set->work_size = std::max(set->work_size, tether->WorkspaceSize());
+    set->tethers.push_back(std::move(at));
+  }
+  if (set->tethers.empty()) return true;
+  m->nuserdata = offset;
+  m->nstack += set->work_size + 64;
+  set->nuserdata = m->nuserdata;
+  {
+    std::unique_lock<std::shared_mutex> lock(g_mutex);
+    g_models[m] = std::move(set);
+    if (!g_installed) {
+      g_previous_passive = mjcb_passive;
+      mjcb_passive = Passive;
+      g_installed = true;
+    }
+  }
+  return true;
+}
+
+void Detach(const mjModel* m) {
+  std::unique_lock<std::shared_mutex> lock(g_mutex);
+  g_models.erase(m);
+}
+
+mjModel* LoadModel(const std::string& path, std::string* error) {
+  if (!mju_user_error) mju_user_error = DefaultError;
+  char buffer[1000] = "";
+  mjModel* m = mj_loadXML(path.c_str(), nullptr, buffer, sizeof(buffer));
+  if (!m) {
+    if (error) *error = path + ": " + buffer;
+    return nullptr;
+  }
+  if (!Attach(m, path, error)) {
+    mj_deleteModel(m);
+    return nullptr;
+  }
+  return m;
+}
+
+mjModel* LoadModelFromString(const std::string& xml, const std::string& name,
+                             std::string* error) {
+  if (!mju_user_error) mju_user_error = DefaultError;
+  auto vfs = std::make_unique<mjVFS>();  // about 2 MB: not on the stack
+  mj_defaultVFS(vfs.get());
+  if (mj_makeEmptyFileVFS(vfs.get(), name.c_str(), static_cast<int>(xml.size())) != 0) {
+    if (error) *error = name + ": cannot create an in-memory file";
+    return nullptr;
+  }
+  const int f = mj_findFileVFS(vfs.get(), name.c_str());
+  std::memcpy(vfs->filedata[f], xml.data(), xml.size());
+  char buffer[1000] = "";
+  mjModel* m = mj_loadXML(name.c_str(), vfs.get(), buffer, sizeof(buffer));
+  mj_deleteVFS(vfs.get());
+  if (!m) {
+    if (error) *error = name + ": " + buffer;
+    return nullptr;
+  }
+  if (!Attach(m, name, error)) {
+    mj_deleteModel(m);
+    return nullptr;
+  }
+  return m;
+}
+
+int TetherCount(const mjModel* m) {
+  const ModelTethers* set = Lookup(m);
+  return set ? static_cast<int>(set->tethers.size()) : 0;
+}
+
+int FindTether(const mjModel* m, const std::string& name) {
+  const ModelTethers* set = Lookup(m);
+  if (!set) return -1;
+  for (size_t k = 0; k < set->tethers.size(); ++k) {
+    if (set->tethers[k].name == name) return static_cast<int>(k);
+  }
+  return -1;
+}
+
+std::string TetherName(const mjModel* m, int k) {
+  const ModelTethers* set = Lookup(m);
+  return set && k >= 0 && k < static_cast<int>(set->tethers.size()) ? set->tethers[k].name : "";
+}
+
+const Tether* GetTether(const mjModel* m, int k) {
+  const ModelTethers* set = Lookup(m);
+  if (!set || k < 0 || k >= static_cast<int>(set->tethers.size())) return nullptr;
+  return &set->tethers[k].tether;
+}
+
+int EndBody(const mjModel* m, int k, int end) {
+  const ModelTethers* set = Lookup(m);
+  if (!set || k < 0 || k >= static_cast<int>(set->tethers.size()) || end < 0 || end > 1) {
+    return -1;
+  }
+  return set->tethers[k].site[end] < 0 ? -1 : set->tethers[k].body[end];
+}
+
+const double* NodePositions(const mjModel* m, const mjData* d, int k) {
+  const double* u = UserBlock(m, d, k);
+  return u && u[kInitialized] != 0 ? u + kHeader : nullptr;
+}
+
+const double* NodeVelocities(const mjModel* m, const mjData* d, int k) {
+  const double* x = NodePositions(m, d, k);
+  return x ? x + 3 * GetTether(m, k)->nodes() : nullptr;
+}
+
+double TetherTime(const mjModel* m, const mjData* d, int k) {
+  const double* u = UserBlock(m, d, k);
+  return u ? u[kTime] : 0;
+}
+
+EndReactions GetReactions(const mjModel* m, const mjData* d, int k) {
+  EndReactions r;
+  const double* u = UserBlock(m, d, k);
+  if (!u || u[kInitialized] == 0) return r;
+  const double* c = u + kForceA;
+  r.force_a = Vec3(c);
+  r.torque_a = Vec3(c + 3);
+  r.force_b = Vec3(c + 6);
+  r.torque_b = Vec3(c + 9);
+  r.tension_a = u[kTensionA];
+  r.tension_b = u[kTensionB];
+  return r;
+}
+
+void GetTensions(const mjModel* m, const mjData* d, int k, double* T) {
+  const Tether* tether = GetTether(m, k);
+  const double* x = NodePositions(m, d, k);
+  if (!tether) return;
+  if (!x) {
+    std::fill(T, T + tether->segments(), 0.0);
+    return;
+  }
+  tether->Tensions(x, x + 3 * tether->nodes(), T);
+}
+
+std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d) {
+  const ModelTethers* set = Lookup(m);
+  if (!set) return std::nullopt;
+  for (const AttachedTether& at : set->tethers) {
+    const double* u = d->userdata + at.offset;
+    if (u[kStatus] == 0) continue;
+    const Tether& t = at.tether;
+    std::ostringstream s;
+    s << set->source << ": tether '" << at.name << "' diverged at t = " << u[kBadTime]
+      << " s at node " << static_cast<int>(u[kBadNode]) << " of " << t.nodes() << " ("
+      << (u[kStatus] == 2 ? "strain beyond max_strain" : "non-finite position or velocity")
+      << "). ";
+    if (t.params().integrator == Integrator::kExplicit) {
+      s << "The explicit integrator's stable step is " << t.ExplicitStableStep()
+        << " s; use integrator=implicit, or fewer segments (now " << t.segments()
+        << "), or a smaller <option timestep> (now " << m->opt.timestep << " s).";
+    } else {
+      s << "Reduce <option timestep> (now " << m->opt.timestep
+        << " s) or set max_step for tether substeps, or use fewer segments (now "
+        << t.segments() << ").";
+    }
+    return s.str();
+  }
+  return std::nullopt;
+}
+
+}  // namespace mjtether

@@ -1,0 +1,85 @@
+// Parameters of one tether and of the water it is in. SI units throughout.
+//
+// These are plain structs: the declaration parser (declaration.h) fills and validates them,
+// the Tether class (tether.h) precomputes everything that never changes from them.
+#ifndef MJTETHER_SRC_PARAMS_H_
+#define MJTETHER_SRC_PARAMS_H_
+
+#include <string>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace mjtether {
+
+using Vec3 = Eigen::Vector3d;
+
+// One bit per physical effect. An effect whose bit is clear is not evaluated at all.
+enum Effect : unsigned {
+  kAxial = 1u << 0,      // elastic tension EA*strain, tension only
+  kDamping = 1u << 1,    // internal axial damping, damping*strain rate
+  kBending = 1u << 2,    // bending stiffness EI (Galerkin curvature at the nodes)
+  kWeight = 1u << 3,     // dry weight, mass_per_length * g
+  kBuoyancy = 1u << 4,   // displaced water, density * pi d^2/4 * g
+  kDrag = 1u << 5,       // Morison quadratic drag, normal (Cdn) and tangential (Cdt)
+  kAddedMass = 1u << 6,  // normal added mass Can * density * pi d^2/4
+  kCurrent = 1u << 7,    // drag on the velocity relative to the current
+  kSeabed = 1u << 8,     // flat seabed: penalty, damping, Coulomb friction
+  kClamp = 1u << 9,      // clamped end(s): tangent held, bending moment to the body
+};
+
+// Name of each effect as written in `effects=` (same order as the bits).
+inline constexpr const char* kEffectNames[] = {"axial",    "damping",    "bending", "weight",
+                                               "buoyancy", "drag",       "added_mass",
+                                               "current",  "seabed",     "clamp"};
+inline constexpr int kNumEffects = 10;
+
+enum class Integrator {
+  kExplicit,  // symplectic Euler, substeps from the stability limit
+  kImplicit,  // linearised backward Euler, banded solve
+};
+
+// The water a tether is in (declared by <text name="water">). Absent: a dry scene.
+struct Water {
+  double density = 1025;         // [kg/m^3]
+  Vec3 current = Vec3::Zero();   // [m/s] uniform current velocity, world frame
+  bool has_seabed = false;       // a flat seabed was declared
+  double seabed = 0;             // [m] height (world z) of the seabed plane
+  double seabed_stiffness = 1e5;  // [N/m^2] normal force per length of tether per penetration
+  double seabed_damping = -1;    // [N s/m^2] per length; < 0: critical for the tether's mass
+  double seabed_friction = 0;    // [-] Coulomb coefficient across the tether
+  double seabed_friction_axial = -1;  // [-] along the tether; < 0: same as seabed_friction
+  double seabed_friction_speed = 0.01;  // [m/s] slip speed over which friction saturates (tanh)
+};
+
+struct TetherParams {
+  double length = 0;           // [m] unstretched length
+  int segments = 0;            // [-] number of segments N (N+1 nodes)
+  double diameter = 0;         // [m] hydrodynamic and buoyancy diameter d
+  double mass_per_length = 0;  // [kg/m] dry mass per unstretched length
+  double EA = 0;               // [N] axial stiffness
+  double EI = 0;               // [N m^2] bending stiffness
+  double damping = 0;          // [N s] internal axial damping: T = EA*eps + damping*deps/dt
+  double Cdn = 0;              // [-] normal drag coefficient, reference area d per length
+  double Cdt = 0;              // [-] tangential drag coefficient, reference area pi*d per length
+  double Can = 0;              // [-] normal added-mass coefficient, reference pi*d^2/4 per length
+  Integrator integrator = Integrator::kImplicit;
+  bool free_end = false;       // end B is not attached (dangling)
+  bool clamp_a = false;        // end A tangent held along its site's x-axis
+  bool clamp_b = false;        // end B tangent held along its site's x-axis
+  int substeps = 0;            // [-] tether steps per call; 0: automatic
+  double max_step = 0;         // [s] largest tether step; 0: automatic
+  double max_strain = 1.0;     // [-] strain above which the run is declared diverged
+  unsigned effects = 0;        // bit set of Effect, resolved by the parser
+};
+
+// Everything a Tether needs from its surroundings.
+struct Environment {
+  Vec3 gravity = Vec3(0, 0, -9.81);  // [m/s^2]
+  bool wet = false;                  // a water declaration exists
+  Water water;
+};
+
+}  // namespace mjtether
+
+#endif  // MJTETHER_SRC_PARAMS_H_

@@ -1,0 +1,680 @@
+#include "tether.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "band_cholesky.h"
+
+namespace mjtether {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+// A segment shorter than this fraction of its rest length has no direction: it carries no
+// tension, no bending shear and no tangent (coincident nodes must not produce NaN).
+constexpr double kMinLengthRatio = 1e-9;
+// Fraction of the explicit stability limit actually used (the estimate ignores drag and the
+// geometric stiffness T/l, both small against EA/L0 in practice).
+constexpr double kExplicitSafety = 0.8;
+
+// Scratch memory of one evaluation, carved from the caller's workspace.
+struct Work {
+  double* f;     // 3 x n   node forces
+  double* t;     // 3 x N   unit segment tangents
+  double* l;     // N       segment lengths
+  double* T;     // N       segment tensions
+  double* M;     // 3 x n   nodal bending moments
+  double* q;     // 3 x n   unit node tangents
+  double* x2;    // 3 x n   state copy for Reactions
+  double* v2;    // 3 x n
+  double* rhs;   // 3 x n   implicit right-hand side / velocity change
+  double* band;  // (3 x n) x 9  implicit band matrix
+  static int Size(int N) {
+    const int n = N + 1;
+    return 3 * n + 3 * N + N + N + 3 * n + 3 * n + 3 * n + 3 * n + 3 * n +
+           BandMatrix::Size(3 * n, 8);
+  }
+  Work(double* w, int N) {
+    const int n = N + 1;
+    f = w;
+    t = f + 3 * n;
+    l = t + 3 * N;
+    T = l + N;
+    M = T + N;
+    q = M + 3 * n;
+    x2 = q + 3 * n;
+    v2 = x2 + 3 * n;
+    rhs = v2 + 3 * n;
+    band = rhs + 3 * n;
+  }
+};
+
+// Cubic Hermite interpolation of an end between two instants dt apart, at fraction s.
+EndState Interpolate(const EndState& e0, const EndState& e1, double dt, double s) {
+  const double s2 = s * s, s3 = s2 * s;
+  const double h00 = 2 * s3 - 3 * s2 + 1, h10 = s3 - 2 * s2 + s;
+  const double h01 = -2 * s3 + 3 * s2, h11 = s3 - s2;
+  const double d00 = 6 * s2 - 6 * s, d10 = 3 * s2 - 4 * s + 1;
+  const double d01 = -6 * s2 + 6 * s, d11 = 3 * s2 - 2 * s;
+  EndState e;
+  e.pos = h00 * e0.pos + h10 * dt * e0.vel + h01 * e1.pos + h11 * dt * e1.vel;
+  e.vel = dt > 0 ? ((d00 * e0.pos + d01 * e1.pos) / dt + d10 * e0.vel + d11 * e1.vel)
+                 : e1.vel;
+  Vec3 axis = (1 - s) * e0.axis + s * e1.axis;
+  e.axis = axis.norm() > 0 ? Vec3(axis.normalized()) : e1.axis;
+  return e;
+}
+
+Ends Interpolate(const Ends& from, const Ends& to, double dt, double s) {
+  return {Interpolate(from.a, to.a, dt, s), Interpolate(from.b, to.b, dt, s)};
+}
+
+}  // namespace
+
+std::optional<Tether> Tether::Create(const TetherParams& params, const Environment& env,
+                                     std::string* error) {
+  auto fail = [&](const std::string& message) -> std::optional<Tether> {
+    if (error) *error = message;
+    return std::nullopt;
+  };
+  if (!(params.segments >= 1)) return fail("segments must be >= 1");
+  if (!(params.length > 0) || !(params.EA > 0) || !(params.mass_per_length > 0) ||
+      !(params.diameter > 0)) {
+    return fail("length, EA, mass_per_length and diameter must be > 0");
+  }
+  Tether tether;
+  Tether& c = tether;
+  c.p_ = params;
+  c.env_ = env;
+  c.N_ = params.segments;
+  c.L0_ = params.length / c.N_;
+  c.area_ = kPi * params.diameter * params.diameter / 4;
+  const int n = c.N_ + 1;
+  const double rho = env.wet ? env.water.density : 0;
+
+  // Lumped masses: half of each adjacent segment.
+  c.share_ = Eigen::VectorXd::Constant(n, c.L0_);
+  c.share_(0) = c.share_(c.N_) = c.L0_ / 2;
+  c.mass_ = params.mass_per_length * c.share_;
+  c.added_ = c.Has(kAddedMass) ? Eigen::VectorXd(params.Can * rho * c.area_ * c.share_)
+                               : Eigen::VectorXd::Zero(n);
+  // Net weight: dry weight minus buoyancy of the displaced volume.
+  c.weight_ = Eigen::Matrix3Xd::Zero(3, n);
+  for (int i = 0; i < n; ++i) {
+    double m = 0;
+    if (c.Has(kWeight)) m += c.mass_(i);
+    if (c.Has(kBuoyancy)) m -= rho * c.area_ * c.share_(i);
+    c.weight_.col(i) = m * env.gravity;
+  }
+  // Morison drag per unit length: 1/2 rho Cdn d |vn| vn and 1/2 rho Cdt pi d |vt| vt.
+  c.kn_ = 0.5 * rho * params.Cdn * params.diameter;
+  c.kt_ = 0.5 * rho * params.Cdt * kPi * params.diameter;
+  // Seabed per unit length; default damping critical for the line's own mass.
+  if (c.Has(kSeabed)) {
+    c.seabed_k_ = env.water.seabed_stiffness;
+    c.seabed_c_ = env.water.seabed_damping >= 0
+                      ? env.water.seabed_damping
+                      : 2 * std::sqrt(c.seabed_k_ * params.mass_per_length);
+  }
+
+  // Explicit stability limit. Highest frequencies of the discrete operators on the lightest
+  // dynamic node: axial chain 4 (EA/L0)/m, fourth difference 16 EI/(L0^3 m) (doubled when an
+  // end is clamped, whose curvature weight is L0/2), seabed k l / m. Damping (internal,
+  // seabed, friction) shortens the limit of symplectic Euler to 2/w (sqrt(1+z^2) - z).
+  double m_min = INFINITY, mn_min = INFINITY;
+  for (int i = 0; i < n; ++i) {
+    if (!c.Dynamic(i)) continue;
+    m_min = std::min(m_min, c.mass_(i));
+    mn_min = std::min(mn_min, c.mass_(i) + c.added_(i));
+  }
+  if (!std::isfinite(m_min)) {
+    c.explicit_dt_ = INFINITY;  // no dynamic node (one segment between two sites)
+  } else {
+    double w2 = 4 * (params.EA / c.L0_) / m_min;
+    if (c.Has(kBending)) {
+      w2 += (c.Has(kClamp) ? 32 : 16) * params.EI / (c.L0_ * c.L0_ * c.L0_ * mn_min);
+    }
+    if (c.Has(kSeabed)) w2 += c.seabed_k_ * c.L0_ / m_min;
+    double rate = 0;  // [1/s] damping / mass
+    if (c.Has(kDamping)) rate += 4 * (params.damping / c.L0_) / m_min;
+    if (c.Has(kSeabed)) {
+      rate += c.seabed_c_ * c.L0_ / m_min;
+      const double mu = std::max(env.water.seabed_friction, env.water.seabed_friction_axial);
+      const double wet = c.weight_.col(1 % n).norm() / std::max(c.share_(1 % n), 1e-300);
+      rate += mu * wet * c.L0_ / (env.water.seabed_friction_speed * m_min);
+    }
+    const double w = std::sqrt(w2);
+    const double zeta = rate / (2 * w);
+    c.explicit_dt_ = kExplicitSafety * 2 / w * (std::sqrt(1 + zeta * zeta) - zeta);
+  }
+  return tether;
+}
+
+int Tether::WorkspaceSize() const { return Work::Size(N_); }
+
+int Tether::SubstepsFor(double dt) const {
+  if (!(dt > 0)) return 0;
+  if (p_.substeps > 0) return p_.substeps;
+  if (p_.max_step > 0) return static_cast<int>(std::ceil(dt / p_.max_step - 1e-9));
+  if (p_.integrator == Integrator::kImplicit) return 1;
+  const double n = std::ceil(dt / explicit_dt_ - 1e-9);
+  return static_cast<int>(std::min(std::max(n, 1.0), 1e9));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Initial shape
+
+void Tether::InitialShape(const Ends& ends, double* xp, double* vp) const {
+  Nodes x(xp, 3, N_ + 1), v(vp, 3, N_ + 1);
+  v.setZero();
+  const Vec3 A = ends.a.pos;
+  const double L = p_.length;
+  // "Down" is the way the net weight pulls; without weight, gravity's way; without gravity, -z.
+  Vec3 down = weight_.col(0).norm() > 0 ? Vec3(weight_.col(0).normalized())
+              : env_.gravity.norm() > 0 ? Vec3(env_.gravity.normalized())
+                                        : Vec3(0, 0, -1);
+  if (p_.free_end) {
+    Vec3 dir = env_.gravity.norm() > 0 ? down : ends.a.axis.normalized();
+    for (int k = 0; k <= N_; ++k) x.col(k) = A + dir * (L * k / N_);
+    v.col(0) = ends.a.vel;
+    return;
+  }
+  const Vec3 B = ends.b.pos;
+  const Vec3 chord = B - A;
+  if (chord.norm() >= L) {
+    // Taut: evenly spaced on the chord (stretched).
+    for (int k = 0; k <= N_; ++k) x.col(k) = A + chord * (double(k) / N_);
+  } else {
+    // Inextensible catenary y = a cosh((s - s0)/a) in the plane of `up` and the horizontal
+    // direction of the chord, through both ends, arc length L:
+    //   sqrt(L^2 - v^2) = 2 a sinh(h / 2a)   (h, v: horizontal and vertical span).
+    const Vec3 up = -down;
+    double vspan = chord.dot(up);
+    Vec3 horiz = chord - vspan * up;
+    double h = horiz.norm();
+    if (h < 1e-6 * L) {
+      // Ends on one vertical: hang a narrow U in any horizontal direction.
+      Vec3 any = std::abs(up.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+      horiz = (any - any.dot(up) * up).normalized() * (1e-6 * L);
+      h = horiz.norm();
+    }
+    const Vec3 eh = horiz / h;
+    // Solve sinh(xi)/xi = r for xi = h/(2a) by bisection (monotone in xi).
+    const double r = std::sqrt(L * L - vspan * vspan) / h;
+    double lo = 0, hi = 1;
+    while (std::sinh(hi) / hi < r && hi < 700) hi *= 2;
+    for (int it = 0; it < 200; ++it) {
+      double mid = 0.5 * (lo + hi);
+      (std::sinh(mid) / mid < r ? lo : hi) = mid;
+    }
+    const double xi = 0.5 * (lo + hi);
+    const double a = h / (2 * xi);
+    const double x0 = h / 2 - a * std::atanh(vspan / L);  // abscissa of the lowest point
+    const double sA = a * std::sinh(-x0 / a);               // arc coordinate of end A
+    for (int k = 0; k <= N_; ++k) {
+      const double s = sA + L * k / N_;
+      const double xc = x0 + a * std::asinh(s / a);
+      const double yc = a * (std::cosh((xc - x0) / a) - std::cosh(x0 / a));
+      x.col(k) = A + xc * eh + yc * up;
+    }
+    x.col(N_) = B;  // remove round-off at the far end
+  }
+  v.col(0) = ends.a.vel;
+  v.col(N_) = ends.b.vel;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Force terms. Convention: n_j = T_j t_j + V_j is the force that the part of the tether beyond
+// segment j exerts across it on the part before; node i receives n_i - n_{i-1}.
+
+void Tether::SegmentGeometry(ConstNodes x, Nodes t, double* l) const {
+  for (int j = 0; j < N_; ++j) {
+    Vec3 dx = x.col(j + 1) - x.col(j);
+    l[j] = dx.norm();
+    if (l[j] > kMinLengthRatio * L0_) {
+      t.col(j) = dx / l[j];
+    } else {
+      t.col(j).setZero();
+      l[j] = 0;
+    }
+  }
+}
+
+// Axial: T_j = EA eps_j + damping deps_j/dt, eps_j = l_j/L0 - 1, zero when slack (eps <= 0)
+// and never negative (Buckham et al. 2003, eq. for the viscoelastic segment).
+void Tether::AddAxial(ConstNodes x, ConstNodes v, ConstNodes t, const double* l, double* T,
+                      Nodes f) const {
+  (void)x;
+  const bool damped = Has(kDamping);
+  for (int j = 0; j < N_; ++j) {
+    const double eps = l[j] / L0_ - 1;
+    double Tj = 0;
+    if (eps > 0) {
+      Tj = p_.EA * eps;
+      if (damped) Tj += p_.damping * t.col(j).dot(v.col(j + 1) - v.col(j)) / L0_;
+      Tj = std::max(Tj, 0.0);
+    }
+    T[j] = Tj;
+    f.col(j) += Tj * t.col(j);
+    f.col(j + 1) -= Tj * t.col(j);
+  }
+}
+
+// Bending moment at each node, M_i = EI kappa_i, with the Galerkin (lumped weight) curvature
+//   kappa_i = (t_{i-1} x t_i) / w_i,  w_i = integral of the hat function N_i = (L0_{i-1}+L0_i)/2
+// (Buckham & Nahon 1999: curvature from the jump of the piecewise-constant tangent, weighted
+// residual with linear shape functions). A clamped end uses its site axis as the tangent
+// before node 0 (or after node N) with w = L0/2; a pinned or free end has M = 0.
+void Tether::BendingMoments(ConstNodes t, const Ends& ends, Nodes M) const {
+  M.setZero();
+  for (int i = 1; i < N_; ++i) {
+    M.col(i) = p_.EI / L0_ * t.col(i - 1).cross(t.col(i));
+  }
+  if (Has(kClamp) && p_.clamp_a) {
+    M.col(0) = p_.EI / (0.5 * L0_) * ends.a.axis.cross(Vec3(t.col(0)));
+  }
+  if (Has(kClamp) && p_.clamp_b) {
+    M.col(N_) = p_.EI / (0.5 * L0_) * Vec3(t.col(N_ - 1)).cross(ends.b.axis);
+  }
+}
+
+// Shear from the moment gradient with no rotational inertia (dM/ds + t x n = 0):
+//   V_j = t_j x (M_{j+1} - M_j) / l_j,
+// added as +V_j on node j and -V_j on node j+1.
+void Tether::AddBending(ConstNodes t, const double* l, ConstNodes M, Nodes f) const {
+  for (int j = 0; j < N_; ++j) {
+    if (l[j] == 0) continue;
+    Vec3 V = Vec3(t.col(j)).cross(Vec3(M.col(j + 1) - M.col(j))) / l[j];
+    f.col(j) += V;
+    f.col(j + 1) -= V;
+  }
+}
+
+// Node tangent: the normalised sum of the adjacent segment tangents (the segment's own at an
+// end). Used for drag, added mass and seabed friction.
+void Tether::NodeTangents(ConstNodes x, ConstNodes t, Nodes q) const {
+  (void)x;
+  for (int i = 0; i <= N_; ++i) {
+    Vec3 s = Vec3::Zero();
+    if (i > 0) s += t.col(i - 1);
+    if (i < N_) s += t.col(i);
+    double norm = s.norm();
+    q.col(i) = norm > 1e-12 ? Vec3(s / norm) : Vec3(t.col(std::min(i, N_ - 1)));
+  }
+}
+
+// Morison drag on the velocity relative to the current u, per unit length (length share
+// l_i = (l_{i-1} + l_i)/2, stretched):
+//   f_n = 1/2 rho Cdn d |vn| vn,   f_t = 1/2 rho Cdt pi d |vt| vt,   v_r = u - v_i.
+void Tether::AddDrag(ConstNodes v, ConstNodes q, const double* l, Nodes f) const {
+  const Vec3 u = Has(kCurrent) ? env_.water.current : Vec3::Zero();
+  for (int i = 0; i <= N_; ++i) {
+    const double li = 0.5 * ((i > 0 ? l[i - 1] : 0) + (i < N_ ? l[i] : 0));
+    const Vec3 vr = u - v.col(i);
+    const Vec3 qi = q.col(i);
+    const Vec3 vt = vr.dot(qi) * qi;
+    const Vec3 vn = vr - vt;
+    f.col(i) += li * (kn_ * vn.norm() * vn + kt_ * vt.norm() * vt);
+  }
+}
+
+// Flat seabed at z = zb: a penalty per unit length (rest share l_i) on penetration
+//   N_i = max(0, k l_i (zb - z_i) - c l_i vz_i),
+// and Coulomb friction smoothed by tanh over the slip speed, separately along the tether's
+// horizontal tangent (mu_axial) and across it (mu).
+void Tether::AddSeabed(ConstNodes x, ConstNodes v, ConstNodes q, Nodes f) const {
+  const Water& w = env_.water;
+  for (int i = 0; i <= N_; ++i) {
+    const double pen = w.seabed - x(2, i);
+    if (pen <= 0) continue;
+    const double N = std::max(0.0, share_(i) * (seabed_k_ * pen - seabed_c_ * v(2, i)));
+    f(2, i) += N;
+    if (w.seabed_friction == 0 && w.seabed_friction_axial == 0) continue;
+    Vec3 qh(q(0, i), q(1, i), 0);
+    qh = qh.norm() > 1e-12 ? Vec3(qh.normalized()) : Vec3::Zero();
+    const Vec3 vh(v(0, i), v(1, i), 0);
+    const Vec3 va = vh.dot(qh) * qh, vc = vh - va;
+    const double eps = w.seabed_friction_speed;
+    if (va.norm() > 0) f.col(i) -= w.seabed_friction_axial * N * std::tanh(va.norm() / eps) *
+                                    va.normalized();
+    if (vc.norm() > 0) f.col(i) -= w.seabed_friction * N * std::tanh(vc.norm() / eps) *
+                                   vc.normalized();
+  }
+}
+
+void Tether::ComputeForces(const double* xp, const double* vp, const Ends& ends, double* fp,
+                           double* Tp, double* work) const {
+  Work w(work, N_);
+  const int n = N_ + 1;
+  ConstNodes x(xp, 3, n), v(vp, 3, n);
+  Nodes f(fp, 3, n), t(w.t, 3, N_), M(w.M, 3, n), q(w.q, 3, n);
+  ConstNodes tc(w.t, 3, N_), Mc(w.M, 3, n), qc(w.q, 3, n);
+  double* T = Tp ? Tp : w.T;
+  f.setZero();
+  SegmentGeometry(x, t, w.l);
+  std::fill(T, T + N_, 0.0);
+  if (Has(kAxial)) AddAxial(x, v, tc, w.l, T, f);
+  if (Has(kBending)) {
+    BendingMoments(tc, ends, M);
+    AddBending(tc, w.l, Mc, f);
+  }
+  if (Has(kWeight) || Has(kBuoyancy)) f += weight_;
+  if (Has(kDrag) || Has(kAddedMass) || Has(kSeabed)) NodeTangents(x, tc, q);
+  if (Has(kDrag)) AddDrag(v, qc, w.l, f);
+  if (Has(kSeabed)) AddSeabed(x, v, qc, f);
+}
+
+EndReactions Tether::Reactions(const double* xp, const double* vp, const Ends& ends,
+                               double* work) const {
+  Work w(work, N_);
+  const int n = N_ + 1;
+  Nodes x(w.x2, 3, n), v(w.v2, 3, n);
+  x = ConstNodes(xp, 3, n);
+  v = ConstNodes(vp, 3, n);
+  x.col(0) = ends.a.pos;
+  v.col(0) = ends.a.vel;
+  if (!p_.free_end) {
+    x.col(N_) = ends.b.pos;
+    v.col(N_) = ends.b.vel;
+  }
+  ComputeForces(w.x2, w.v2, ends, w.f, w.T, work);
+  ConstNodes f(w.f, 3, n), M(w.M, 3, n);
+  EndReactions r;
+  r.force_a = f.col(0);
+  r.tension_a = r.force_a.norm();
+  if (Has(kClamp) && p_.clamp_a) r.torque_a = M.col(0);
+  if (p_.free_end) {
+    r.tension_b = w.T[N_ - 1];
+  } else {
+    r.force_b = f.col(N_);
+    r.tension_b = r.force_b.norm();
+    if (Has(kClamp) && p_.clamp_b) r.torque_b = -M.col(N_);
+  }
+  return r;
+}
+
+void Tether::Tensions(const double* xp, const double* vp, double* T) const {
+  ConstNodes x(xp, 3, N_ + 1), v(vp, 3, N_ + 1);
+  for (int j = 0; j < N_; ++j) {
+    Vec3 dx = x.col(j + 1) - x.col(j);
+    const double l = dx.norm();
+    const double eps = l / L0_ - 1;
+    T[j] = 0;
+    if (eps > 0 && Has(kAxial)) {
+      T[j] = p_.EA * eps;
+      if (Has(kDamping)) T[j] += p_.damping * (dx / l).dot(v.col(j + 1) - v.col(j)) / L0_;
+      T[j] = std::max(T[j], 0.0);
+    }
+  }
+}
+
+double Tether::KineticEnergy(const double* xp, const double* vp) const {
+  ConstNodes x(xp, 3, N_ + 1), v(vp, 3, N_ + 1);
+  double E = 0;
+  for (int i = 0; i <= N_; ++i) {
+    E += 0.5 * mass_(i) * v.col(i).squaredNorm();
+    if (added_(i) > 0) {
+      Vec3 s = x.col(std::min(i + 1, N_)) - x.col(std::max(i - 1, 0));
+      Vec3 q = s.norm() > 0 ? Vec3(s.normalized()) : Vec3::Zero();
+      Vec3 vn = v.col(i) - v.col(i).dot(q) * q;
+      E += 0.5 * added_(i) * vn.squaredNorm();
+    }
+  }
+  return E;
+}
+
+double Tether::PotentialEnergy(const double* xp, const Ends& ends) const {
+  ConstNodes x(xp, 3, N_ + 1);
+  double E = 0;
+  Vec3 t_prev = Vec3::Zero();
+  for (int j = 0; j < N_; ++j) {
+    Vec3 dx = x.col(j + 1) - x.col(j);
+    const double l = dx.norm();
+    if (Has(kAxial) && l > L0_) E += 0.5 * p_.EA / L0_ * (l - L0_) * (l - L0_);
+    Vec3 t = l > 0 ? Vec3(dx / l) : Vec3::Zero();
+    if (Has(kBending)) {
+      if (j > 0) E += 0.5 * p_.EI / L0_ * t_prev.cross(t).squaredNorm();
+      if (j == 0 && Has(kClamp) && p_.clamp_a) {
+        E += 0.5 * p_.EI / (0.5 * L0_) * ends.a.axis.cross(t).squaredNorm();
+      }
+      if (j == N_ - 1 && Has(kClamp) && p_.clamp_b) {
+        E += 0.5 * p_.EI / (0.5 * L0_) * t.cross(ends.b.axis).squaredNorm();
+      }
+    }
+    t_prev = t;
+  }
+  for (int i = 0; i <= N_; ++i) E -= weight_.col(i).dot(x.col(i));
+  return E;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Integrators
+
+// Symplectic (semi-implicit) Euler: v += h M^-1 f(x, v); x += h v. With normal added mass the
+// node mass matrix is m I + ma (I - q q^T), whose inverse is q q^T/m + (I - q q^T)/(m + ma).
+void Tether::ExplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
+                          double* work) const {
+  Work w(work, N_);
+  ComputeForces(x.data(), v.data(), now, w.f, nullptr, work);
+  ConstNodes f(w.f, 3, N_ + 1), q(w.q, 3, N_ + 1);
+  const bool added = Has(kAddedMass);
+  for (int i = 1; i <= N_; ++i) {
+    if (!Dynamic(i)) continue;
+    Vec3 a;
+    if (added) {
+      const Vec3 qi = q.col(i), fi = f.col(i);
+      const Vec3 ft = fi.dot(qi) * qi;
+      a = ft / mass_(i) + (fi - ft) / (mass_(i) + added_(i));
+    } else {
+      a = f.col(i) / mass_(i);
+    }
+    v.col(i) += h * a;
+    x.col(i) += h * v.col(i);
+  }
+  x.col(0) = next.a.pos;
+  v.col(0) = next.a.vel;
+  if (!p_.free_end) {
+    x.col(N_) = next.b.pos;
+    v.col(N_) = next.b.vel;
+  }
+}
+
+// Backward Euler, solved by Newton's method on the velocities at the end of the step:
+//   G(v+) = M (v+ - v) - h f(x + h v+, v+) = 0,
+//   (M - h D - h^2 K) dv = -G,   K = df/dx, D = df/dv at the current iterate,
+// starting from v+ = v with the attached ends already at their positions and velocities at
+// the end of the step. The linear system is the one of Baraff & Witkin (SIGGRAPH 1998); with
+// smooth forces one iteration suffices. The tension-only law is not smooth: a segment that
+// changes between slack and taut during the step invalidates the linearisation, so the
+// iteration repeats (at most kMaxNewton times) until the set of taut segments settles.
+//
+// K holds the axial stiffness EA/L0 t t^T + T/l (I - t t^T) of taut segments, the small-angle
+// bending stiffness EI/w g g^T (g the second-difference stencil of the curvature), and the
+// seabed stiffness; D the axial damping, the drag and seabed damping, and the secant of the
+// friction. Every block is symmetric and K <= 0, D <= 0, so the matrix is SPD and banded
+// (3x3 blocks, two off-diagonals with bending, one without): a band Cholesky solves it.
+void Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
+                          double* work) const {
+  (void)now;
+  constexpr int kMaxNewton = 4;
+  Work w(work, N_);
+  const int n = N_ + 1;
+  const int nu = N_ - 1 + (p_.free_end ? 1 : 0);  // dynamic nodes 1..nu, unknown u = i - 1
+  Nodes xk(w.x2, 3, n), vk(w.v2, 3, n);
+  // Initial iterate: velocities unchanged, ends at the end of the step.
+  vk = v;
+  vk.col(0) = next.a.vel;
+  if (!p_.free_end) vk.col(N_) = next.b.vel;
+  auto place = [&]() {
+    xk = x + h * vk;
+    xk.col(0) = next.a.pos;
+    if (!p_.free_end) xk.col(N_) = next.b.pos;
+  };
+  place();
+  if (nu == 0) {
+    x = xk;
+    v = vk;
+    return;
+  }
+  ConstNodes f(w.f, 3, n), t(w.t, 3, N_), q(w.q, 3, n);
+  const int band_p = Has(kBending) ? 8 : 5;
+  BandMatrix A(w.band, 3 * nu, band_p);
+  Nodes rhs(w.rhs, 3, nu);
+  const Mat3 I = Mat3::Identity();
+  const Mat3 Z = Mat3::Zero();
+
+  // Adds df_i/dx_j = K, df_i/dv_j = D of the current iterate to A (lower triangle only).
+  auto couple = [&](int i, int j, const Mat3& K, const Mat3& D) {
+    if (!Dynamic(i) || !Dynamic(j) || j > i) return;
+    const Mat3 B = -h * D - h * h * K;
+    const int r0 = 3 * (i - 1), c0 = 3 * (j - 1);
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) {
+        if (i == j && c > r) continue;
+        A.Add(r0 + r, c0 + c, B(r, c));
+      }
+    }
+  };
+
+  for (int iter = 0; iter < kMaxNewton; ++iter) {
+    ComputeForces(w.x2, w.v2, next, w.f, w.T, work);
+    A.SetZero();
+    // Node mass with normal added mass; residual -G = h f - M (v+ - v).
+    for (int i = 1; i <= nu; ++i) {
+      Mat3 Mi = mass_(i) * I;
+      if (Has(kAddedMass)) Mi += added_(i) * (I - q.col(i) * q.col(i).transpose());
+      rhs.col(i - 1) = h * f.col(i) - Mi * (vk.col(i) - v.col(i));
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c <= r; ++c) A.Add(3 * (i - 1) + r, 3 * (i - 1) + c, Mi(r, c));
+      }
+    }
+    // Axial stiffness and damping of taut segments.
+    if (Has(kAxial)) {
+      for (int j = 0; j < N_; ++j) {
+        if (!(w.l[j] > L0_) || w.l[j] == 0) continue;
+        const Mat3 tt = t.col(j) * t.col(j).transpose();
+        const Mat3 K = p_.EA / L0_ * tt + w.T[j] / w.l[j] * (I - tt);
+        const Mat3 D = Has(kDamping) && w.T[j] > 0 ? Mat3(p_.damping / L0_ * tt) : Z;
+        couple(j, j, -K, -D);
+        couple(j + 1, j, K, D);
+        couple(j + 1, j + 1, -K, -D);
+      }
+    }
+    // Bending: K = -EI/w g g^T I on the stencil of each curvature.
+    if (Has(kBending)) {
+      auto stencil = [&](const int* nodes, const double* g, int count, double weight) {
+        const double k = p_.EI / (weight * L0_ * L0_);
+        for (int a = 0; a < count; ++a) {
+          for (int b = 0; b <= a; ++b) {
+            couple(nodes[a], nodes[b], -k * g[a] * g[b] * I, Z);
+          }
+        }
+      };
+      const double g3[3] = {1, -2, 1}, g2[2] = {-1, 1};
+      for (int i = 1; i < N_; ++i) {
+        const int nodes[3] = {i - 1, i, i + 1};
+        stencil(nodes, g3, 3, L0_);
+      }
+      if (Has(kClamp) && p_.clamp_a) {
+        const int nodes[2] = {0, 1};
+        stencil(nodes, g2, 2, 0.5 * L0_);
+      }
+      if (Has(kClamp) && p_.clamp_b) {
+        const int nodes[2] = {N_ - 1, N_};
+        stencil(nodes, g2, 2, 0.5 * L0_);
+      }
+    }
+    // Drag: d(|vn| vn)/dv_r = |vn| P + vn vn^T/|vn|, d(|vt| vt)/dv_r = 2 |vt| q q^T.
+    if (Has(kDrag)) {
+      const Vec3 u = Has(kCurrent) ? env_.water.current : Vec3::Zero();
+      for (int i = 1; i <= nu; ++i) {
+        const double li = 0.5 * (w.l[i - 1] + (i < N_ ? w.l[i] : 0));
+        const Vec3 qi = q.col(i);
+        const Vec3 vr = u - vk.col(i);
+        const Vec3 vt = vr.dot(qi) * qi, vn = vr - vt;
+        const Mat3 P = I - qi * qi.transpose();
+        Mat3 J = kt_ * 2 * vt.norm() * qi * qi.transpose();
+        if (vn.norm() > 0) J += kn_ * (vn.norm() * P + vn * vn.transpose() / vn.norm());
+        couple(i, i, Z, -li * J);
+      }
+    }
+    // Seabed: normal stiffness and damping, friction secant.
+    if (Has(kSeabed)) {
+      const Water& wt = env_.water;
+      for (int i = 1; i <= nu; ++i) {
+        const double pen = wt.seabed - xk(2, i);
+        if (pen <= 0) continue;
+        Mat3 K = Z, D = Z;
+        K(2, 2) = -seabed_k_ * share_(i);
+        D(2, 2) = -seabed_c_ * share_(i);
+        const double N = std::max(0.0, share_(i) * (seabed_k_ * pen - seabed_c_ * vk(2, i)));
+        const double mu = std::max(wt.seabed_friction, wt.seabed_friction_axial);
+        const double vh = std::hypot(vk(0, i), vk(1, i));
+        const double eps = wt.seabed_friction_speed;
+        const double secant = vh > 1e-9 * eps ? mu * N * std::tanh(vh / eps) / vh : mu * N / eps;
+        D(0, 0) = D(1, 1) = -secant;
+        couple(i, i, K, D);
+      }
+    }
+    // Solve; a failed factorisation leaves NaN behind for the divergence check to report.
+    if (A.Factor() >= 0) {
+      vk.col(1).setConstant(NAN);
+      break;
+    }
+    A.Solve(w.rhs);
+    for (int i = 1; i <= nu; ++i) vk.col(i) += rhs.col(i - 1);
+    // Did a segment change between slack and taut? Then the linearisation was wrong there.
+    place();
+    bool changed = false;
+    for (int j = 0; j < N_ && !changed; ++j) {
+      changed = ((xk.col(j + 1) - xk.col(j)).norm() > L0_) != (w.l[j] > L0_);
+    }
+    if (!changed) break;
+  }
+  x = xk;
+  v = vk;
+}
+
+StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends& to, double dt,
+                           double* work) const {
+  const int n = N_ + 1;
+  Nodes x(xp, 3, n), v(vp, 3, n);
+  StepStatus status;
+  const int steps = SubstepsFor(dt);
+  if (steps == 0) return status;
+  const double h = dt / steps;
+  Ends now = from;
+  x.col(0) = from.a.pos;
+  v.col(0) = from.a.vel;
+  if (!p_.free_end) {
+    x.col(N_) = from.b.pos;
+    v.col(N_) = from.b.vel;
+  }
+  for (int k = 0; k < steps; ++k) {
+    const Ends next = k + 1 == steps ? to : Interpolate(from, to, dt, double(k + 1) / steps);
+    if (p_.integrator == Integrator::kExplicit) {
+      ExplicitStep(x, v, now, next, h, work);
+    } else {
+      ImplicitStep(x, v, now, next, h, work);
+    }
+    now = next;
+  }
+  // Divergence: a non-finite value, or a strain no tether survives.
+  for (int i = 0; i < n; ++i) {
+    if (!x.col(i).allFinite() || !v.col(i).allFinite()) {
+      status = {false, i, "non-finite position or velocity"};
+      return status;
+    }
+  }
+  for (int j = 0; j < N_; ++j) {
+    const double strain = (x.col(j + 1) - x.col(j)).norm() / L0_ - 1;
+    if (strain > p_.max_strain) {
+      status = {false, j + 1,
+                "strain " + std::to_string(strain) + " of segment " + std::to_string(j) +
+                    " exceeds max_strain " + std::to_string(p_.max_strain)};
+      return status;
+    }
+  }
+  return status;
+}
+
+}  // namespace mjtether

@@ -1,0 +1,157 @@
+// A lumped-mass tether: N+1 point masses joined by N massless viscoelastic segments, with
+// bending from nodal curvature (Buckham & Nahon, "Dynamics simulation of low tension tethers",
+// OCEANS '99; Buckham, Driscoll & Nahon, "Formulation and validation of a lumped mass model
+// for low-tension ROV tethers", ISOPE 2003), Morison drag and added mass, weight and buoyancy,
+// and a flat seabed.
+//
+// The object holds only what never changes (masses, coefficients, stability limit). The state
+// (node positions x and velocities v, each 3 x (N+1), column per node) lives in a buffer the
+// caller owns, and all scratch memory comes from a caller-supplied workspace of
+// WorkspaceSize() doubles, so that stepping allocates nothing and one Tether serves any number
+// of states and threads.
+//
+// End A (node 0) is attached to a site; end B (node N) is attached to a site or free. Attached
+// end nodes follow their site; the force the tether exerts on a site is the total force on its
+// end node (segment tension, bending shear, and the node's share of weight, buoyancy, drag and
+// seabed contact). The end node's inertia is not passed on.
+#ifndef MJTETHER_SRC_TETHER_H_
+#define MJTETHER_SRC_TETHER_H_
+
+#include <optional>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "params.h"
+
+namespace mjtether {
+
+using Mat3 = Eigen::Matrix3d;
+using Nodes = Eigen::Map<Eigen::Matrix3Xd>;             // 3 x n, one column per node
+using ConstNodes = Eigen::Map<const Eigen::Matrix3Xd>;  // 3 x n
+
+// The kinematics of one attached end at one instant.
+struct EndState {
+  Vec3 pos = Vec3::Zero();   // [m] site position, world frame
+  Vec3 vel = Vec3::Zero();   // [m/s] site velocity, world frame
+  Vec3 axis = Vec3::UnitX();  // [-] site x-axis (clamp direction, pointing into the tether)
+};
+
+struct Ends {
+  EndState a;
+  EndState b;  // unused when end B is free
+};
+
+// What the tether does to the sites it is attached to.
+struct EndReactions {
+  Vec3 force_a = Vec3::Zero();   // [N] force on site A
+  Vec3 torque_a = Vec3::Zero();  // [N m] moment on site A's body (clamped end only)
+  Vec3 force_b = Vec3::Zero();   // [N] force on site B (zero when B is free)
+  Vec3 torque_b = Vec3::Zero();  // [N m]
+  double tension_a = 0;          // [N] |force_a|
+  double tension_b = 0;          // [N] |force_b|, or the last segment's tension when B is free
+};
+
+// Outcome of Advance: ok, or where the state stopped making sense.
+struct StepStatus {
+  bool ok = true;
+  int node = -1;         // first offending node
+  std::string reason;    // "non-finite position", "strain 1.3 > max_strain 1", ...
+};
+
+class Tether {
+ public:
+  // Precomputes masses, coefficients and the explicit stability limit. Returns nothing (and
+  // sets *error) if the parameters are inconsistent (they are range-checked by the parser).
+  static std::optional<Tether> Create(const TetherParams& params, const Environment& env,
+                                      std::string* error);
+
+  const TetherParams& params() const { return p_; }
+  const Environment& env() const { return env_; }
+  int segments() const { return N_; }
+  int nodes() const { return N_ + 1; }
+  double rest_segment_length() const { return L0_; }  // [m]
+  // Doubles in one state: x then v, 3 x (N+1) each.
+  int StateSize() const { return 6 * (N_ + 1); }
+  // Doubles of scratch memory that Advance, ComputeForces and Reactions need.
+  int WorkspaceSize() const;
+
+  // Largest stable step of the explicit scheme [s]: 2/omega_max with the highest natural
+  // frequency estimated from axial stiffness, bending, seabed stiffness and the node masses,
+  // reduced for damping (see tether.cc).
+  double ExplicitStableStep() const { return explicit_dt_; }
+  // Number of tether steps to cover dt [s] with the configured integrator.
+  int SubstepsFor(double dt) const;
+
+  // Initial shape: a straight line when the ends are at least `length` apart, otherwise an
+  // inextensible catenary of the right length in the vertical plane through both ends (sagging
+  // with the net weight); a free end hangs along gravity (or along site A's axis without
+  // gravity). Velocities: zero inside, the sites' at the ends.
+  void InitialShape(const Ends& ends, double* x, double* v) const;
+
+  // Advances the state by dt [s]; the attached ends move from `from` to `to` (cubic Hermite in
+  // time between the two, so positions and velocities at both instants are matched).
+  StepStatus Advance(double* x, double* v, const Ends& from, const Ends& to, double dt,
+                     double* work) const;
+
+  // Forces on every node f (3 x n) [N], and segment tensions T (N) [N] when T is not null,
+  // from the state as it is (ends as stored in x, v).
+  void ComputeForces(const double* x, const double* v, const Ends& ends, double* f, double* T,
+                     double* work) const;
+
+  // Forces and moments on the sites, with the end nodes placed at the sites given (so a
+  // caller can evaluate the reaction at an intermediate state of its own integrator).
+  EndReactions Reactions(const double* x, const double* v, const Ends& ends,
+                         double* work) const;
+
+  // Segment tensions T (N) [N] of the state as it is.
+  void Tensions(const double* x, const double* v, double* T) const;
+
+  // Energies [J] for conservation checks: kinetic (with added mass), elastic (axial and
+  // bending) and gravitational (weight minus buoyancy, relative to z = 0).
+  double KineticEnergy(const double* x, const double* v) const;
+  double PotentialEnergy(const double* x, const Ends& ends) const;
+
+  // Node masses [kg] (dry, lumped) and net weight force [N] per node.
+  double node_mass(int i) const { return mass_[i]; }
+  Vec3 node_weight(int i) const { return weight_.col(i); }
+
+ private:
+  Tether() = default;
+
+  // Per-effect terms; each adds to f (3 x n). See tether.cc for the equations.
+  void SegmentGeometry(ConstNodes x, Nodes t, double* l) const;
+  void AddAxial(ConstNodes x, ConstNodes v, ConstNodes t, const double* l, double* T,
+                Nodes f) const;
+  void BendingMoments(ConstNodes t, const Ends& ends, Nodes M) const;
+  void AddBending(ConstNodes t, const double* l, ConstNodes M, Nodes f) const;
+  void NodeTangents(ConstNodes x, ConstNodes t, Nodes q) const;
+  void AddDrag(ConstNodes v, ConstNodes q, const double* l, Nodes f) const;
+  void AddSeabed(ConstNodes x, ConstNodes v, ConstNodes q, Nodes f) const;
+
+  // Integrators (one step of size h; ends already set at the start, `next` at the end).
+  void ExplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
+                    double* work) const;
+  void ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
+                    double* work) const;
+
+  bool Has(unsigned effect) const { return (p_.effects & effect) != 0; }
+  bool Dynamic(int i) const { return i > 0 && (i < N_ || p_.free_end); }
+
+  TetherParams p_;
+  Environment env_;
+  int N_ = 0;
+  double L0_ = 0;               // [m] rest length of a segment
+  double area_ = 0;             // [m^2] pi d^2 / 4
+  double kn_ = 0, kt_ = 0;      // [kg/m^2] 1/2 rho Cdn d, 1/2 rho Cdt pi d (per length)
+  double seabed_k_ = 0, seabed_c_ = 0;  // [N/m^2], [N s/m^2] per length
+  double explicit_dt_ = 0;      // [s]
+  Eigen::VectorXd mass_;        // [kg] (n) dry lumped mass
+  Eigen::VectorXd added_;       // [kg] (n) normal added mass Can rho A l_i
+  Eigen::VectorXd share_;       // [m] (n) rest length lumped at each node
+  Eigen::Matrix3Xd weight_;     // [N] (3 x n) weight minus buoyancy per node
+};
+
+}  // namespace mjtether
+
+#endif  // MJTETHER_SRC_TETHER_H_

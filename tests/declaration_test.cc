@@ -1,0 +1,155 @@
+// Tests of the declaration parser: every class of bad input gets a message naming the key
+// and, for numbers, the allowed range.
+#include <gtest/gtest.h>
+
+#include "declaration.h"
+
+namespace mjtether {
+namespace {
+
+const char* kExample =
+    "ends=tms_port,rov_attach length=40 segments=40\n"
+    "            diameter=0.02 mass_per_length=0.35 EA=2e5 EI=0.5 damping=50\n"
+    "            Cdn=1.2 Cdt=0.01 Can=1.0 integrator=implicit";
+
+Environment Wet() {
+  Environment env;
+  env.wet = true;
+  env.water.current = Vec3(0.3, 0, 0);
+  env.water.has_seabed = true;
+  env.water.seabed = -60;
+  return env;
+}
+
+TEST(Declaration, ParsesTheDocumentedExample) {
+  DeclarationError e;
+  std::optional<TetherDeclaration> d = ParseTether(kExample, Wet(), &e);
+  ASSERT_TRUE(d) << e.message;
+  EXPECT_EQ(d->site_a, "tms_port");
+  EXPECT_EQ(d->site_b, "rov_attach");
+  EXPECT_EQ(d->params.segments, 40);
+  EXPECT_DOUBLE_EQ(d->params.EA, 2e5);
+  EXPECT_DOUBLE_EQ(d->params.EI, 0.5);
+  EXPECT_DOUBLE_EQ(d->params.Can, 1.0);
+  EXPECT_EQ(d->params.integrator, Integrator::kImplicit);
+  // Every effect the declaration calls for, and no clamp.
+  EXPECT_EQ(EffectsToString(d->params.effects),
+            "axial,damping,bending,weight,buoyancy,drag,added_mass,current,seabed");
+}
+
+TEST(Declaration, DryScenesHaveNoHydrodynamics) {
+  DeclarationError e;
+  Environment dry;
+  std::optional<TetherDeclaration> d = ParseTether(kExample, dry, &e);
+  ASSERT_TRUE(d) << e.message;
+  EXPECT_EQ(EffectsToString(d->params.effects), "axial,damping,bending,weight");
+}
+
+TEST(Declaration, ZeroCoefficientsTurnEffectsOff) {
+  DeclarationError e;
+  std::optional<TetherDeclaration> d = ParseTether(
+      "ends=a,free length=1 segments=1 diameter=0.01 mass_per_length=0.1 EA=1e3 EI=0 "
+      "damping=0 Cdn=0 Cdt=0 Can=0",
+      Wet(), &e);
+  ASSERT_TRUE(d) << e.message;
+  EXPECT_TRUE(d->params.free_end);
+  EXPECT_EQ(EffectsToString(d->params.effects), "axial,weight,buoyancy,seabed");
+}
+
+TEST(Declaration, ExplicitEffectsReplaceDefaults) {
+  DeclarationError e;
+  std::optional<TetherDeclaration> d =
+      ParseTether(std::string(kExample) + " effects=axial,drag", Wet(), &e);
+  ASSERT_TRUE(d) << e.message;
+  EXPECT_EQ(d->params.effects, unsigned(kAxial | kDrag));
+}
+
+struct BadCase {
+  const char* what;
+  std::string text;
+  const char* key;       // the key the message must name
+  const char* fragment;  // and a fragment it must contain (the range, the allowed values)
+};
+
+class BadTether : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(BadTether, IsRejectedWithKeyAndRange) {
+  const BadCase& c = GetParam();
+  DeclarationError e;
+  EXPECT_FALSE(ParseTether(c.text, Wet(), &e)) << c.what;
+  EXPECT_EQ(e.key, c.key) << c.what << ": " << e.message;
+  EXPECT_NE(e.message.find(c.key), std::string::npos) << e.message;
+  EXPECT_NE(e.message.find(c.fragment), std::string::npos) << c.what << ": " << e.message;
+}
+
+std::string With(const std::string& replace, const std::string& by) {
+  std::string s = kExample;
+  s.replace(s.find(replace), replace.size(), by);
+  return s;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Declaration, BadTether,
+    ::testing::Values(
+        BadCase{"unknown key", std::string(kExample) + " colour=red", "colour", "allowed keys"},
+        BadCase{"not a number", With("EA=2e5", "EA=abc"), "EA", "not a number"},
+        BadCase{"trailing junk", With("EA=2e5", "EA=2e5N"), "EA", "not a number"},
+        BadCase{"NaN", With("EA=2e5", "EA=nan"), "EA", "not a finite number"},
+        BadCase{"infinity", With("EA=2e5", "EA=inf"), "EA", "not a finite number"},
+        BadCase{"overflow", With("EA=2e5", "EA=1e999"), "EA", "not a finite number"},
+        BadCase{"negative", With("EA=2e5", "EA=-1"), "EA", "(0, 1e+13]"},
+        BadCase{"zero where not allowed", With("length=40", "length=0"), "length", "(0, 100000]"},
+        BadCase{"negative EI", With("EI=0.5", "EI=-0.5"), "EI", "[0, 1e+12]"},
+        BadCase{"segments < 1", With("segments=40", "segments=0"), "segments", "[1, 100000]"},
+        BadCase{"huge segments", With("segments=40", "segments=1e9"), "segments",
+                "[1, 100000]"},
+        BadCase{"fractional segments", With("segments=40", "segments=2.5"), "segments",
+                "whole number"},
+        BadCase{"missing key", With("EA=2e5 ", ""), "EA", "missing required key"},
+        BadCase{"duplicate key", std::string(kExample) + " EA=3e5", "EA", "twice"},
+        BadCase{"one end", With("ends=tms_port,rov_attach", "ends=tms_port"), "ends",
+                "two site names"},
+        BadCase{"same site twice", With("ends=tms_port,rov_attach", "ends=a,a"), "ends",
+                "both ends"},
+        BadCase{"free end A", With("ends=tms_port,rov_attach", "ends=free,b"), "ends",
+                "only end B"},
+        BadCase{"bad integrator", With("integrator=implicit", "integrator=rk9"), "integrator",
+                "explicit, implicit"},
+        BadCase{"bad clamp", std::string(kExample) + " clamp=C", "clamp", "A, B, both"},
+        BadCase{"clamp without EI", With("EI=0.5", "EI=0") + " clamp=A", "clamp", "EI > 0"},
+        BadCase{"clamp a free end",
+                With("ends=tms_port,rov_attach", "ends=a,free") + " clamp=B", "clamp",
+                "free"},
+        BadCase{"unknown effect", std::string(kExample) + " effects=axial,magic", "effects",
+                "allowed"},
+        BadCase{"effect without coefficient", With("EI=0.5", "EI=0") + " effects=axial,bending",
+                "effects", "EI > 0"},
+        BadCase{"no axial", std::string(kExample) + " effects=drag", "effects", "axial"}));
+
+TEST(Declaration, MalformedTextIsRejected) {
+  DeclarationError e;
+  EXPECT_FALSE(ParseTether("ends=a,b length 40", Wet(), &e));
+  EXPECT_NE(e.message.find("'length' is not of the form key=value"), std::string::npos)
+      << e.message;
+  EXPECT_FALSE(ParseTether("ends=a,b length=", Wet(), &e));
+  EXPECT_NE(e.message.find("needs both a key and a value"), std::string::npos) << e.message;
+}
+
+TEST(Declaration, WaterKeysAreChecked) {
+  DeclarationError e;
+  std::optional<Water> w = ParseWater("density=1025 current=0.3,0,0 seabed=-60", &e);
+  ASSERT_TRUE(w) << e.message;
+  EXPECT_TRUE(w->has_seabed);
+  EXPECT_DOUBLE_EQ(w->current.x(), 0.3);
+  EXPECT_FALSE(ParseWater("current=0.3,0", &e));
+  EXPECT_EQ(e.key, "current");
+  EXPECT_FALSE(ParseWater("density=-1", &e));
+  EXPECT_NE(e.message.find("(0, 10000]"), std::string::npos) << e.message;
+  EXPECT_FALSE(ParseWater("seabed_friction=0.5", &e));
+  EXPECT_EQ(e.key, "seabed");
+  EXPECT_FALSE(ParseWater("salinity=35", &e));
+  EXPECT_NE(e.message.find("allowed keys"), std::string::npos) << e.message;
+}
+
+}  // namespace
+}  // namespace mjtether

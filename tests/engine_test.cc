@@ -1,0 +1,328 @@
+// Tests of the tether engine alone (no MuJoCo): closed forms, conservation laws.
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include <Eigen/Dense>
+#include <gtest/gtest.h>
+
+#include "band_cholesky.h"
+#include "catenary_reference.h"
+#include "declaration.h"
+#include "tether.h"
+
+namespace mjtether {
+namespace {
+
+// A tether with its state and workspace, for tests.
+struct Sim {
+  Tether tether;
+  std::vector<double> x, v, work;
+  Ends ends;
+  explicit Sim(const Tether& t)
+      : tether(t), x(3 * t.nodes()), v(3 * t.nodes()), work(t.WorkspaceSize()) {}
+  void Init() { tether.InitialShape(ends, x.data(), v.data()); }
+  StepStatus Step(double dt) {
+    return tether.Advance(x.data(), v.data(), ends, ends, dt, work.data());
+  }
+  Vec3 node(int i) const { return Vec3(x[3 * i], x[3 * i + 1], x[3 * i + 2]); }
+  double Energy() const {
+    return tether.KineticEnergy(x.data(), v.data()) + tether.PotentialEnergy(x.data(), ends);
+  }
+  EndReactions Reactions() { return tether.Reactions(x.data(), v.data(), ends, work.data()); }
+};
+
+Tether Make(const TetherParams& p, const Environment& env, const std::string& effects = "") {
+  TetherParams q = p;
+  DeclarationError e;
+  std::optional<unsigned> fx = ResolveEffects(q, env, effects, &e);
+  EXPECT_TRUE(fx.has_value()) << e.message;
+  q.effects = fx.value_or(kAxial);
+  std::string error;
+  std::optional<Tether> t = Tether::Create(q, env, &error);
+  EXPECT_TRUE(t.has_value()) << error;
+  return *t;
+}
+
+TetherParams CatenaryParams(int segments) {
+  TetherParams p;
+  p.length = 100;
+  p.segments = segments;
+  p.diameter = 0.02;
+  p.mass_per_length = 1.0;
+  p.EA = 1e5;  // strain about 1% at the ~1 kN tensions below: elasticity matters
+  p.damping = 2e3;
+  p.integrator = Integrator::kImplicit;
+  return p;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+TEST(BandCholesky, MatchesDenseSolve) {
+  // A random SPD matrix with half-bandwidth 8, as the implicit step builds.
+  const int n = 60, p = 8;
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> U(-1, 1);
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n, n);
+  for (int i = 0; i < n; ++i) {
+    for (int j = std::max(0, i - p); j < i; ++j) A(i, j) = A(j, i) = U(rng);
+    A(i, i) = 2 * p + 1;  // diagonally dominant
+  }
+  Eigen::VectorXd b = Eigen::VectorXd::NullaryExpr(n, [&]() { return U(rng); });
+  std::vector<double> storage(BandMatrix::Size(n, p));
+  BandMatrix B(storage.data(), n, p);
+  B.SetZero();
+  for (int i = 0; i < n; ++i) {
+    for (int j = std::max(0, i - p); j <= i; ++j) B.Add(i, j, A(i, j));
+  }
+  ASSERT_EQ(B.Factor(), -1);
+  Eigen::VectorXd x = b;
+  B.Solve(x.data());
+  Eigen::VectorXd ref = A.llt().solve(b);
+  EXPECT_LT((x - ref).norm(), 1e-12 * ref.norm());
+}
+
+TEST(BandCholesky, ReportsIndefiniteMatrix) {
+  std::vector<double> storage(BandMatrix::Size(3, 1));
+  BandMatrix B(storage.data(), 3, 1);
+  B.SetZero();
+  B.Add(0, 0, 1);
+  B.Add(1, 0, 2);  // [[1,2],[2,1]] is indefinite
+  B.Add(1, 1, 1);
+  B.Add(2, 2, 1);
+  EXPECT_EQ(B.Factor(), 1);
+}
+
+// The slack initial shape is a catenary of the declared length through both ends, never a
+// compressed straight line.
+TEST(InitialShape, SlackCatenaryHasDeclaredLength) {
+  Environment env;
+  Sim s(Make(CatenaryParams(40), env));
+  s.ends.a.pos = Vec3(0, 0, 0);
+  s.ends.b.pos = Vec3(60, 30, 20);
+  s.Init();
+  double length = 0, lowest = 0;
+  for (int i = 0; i < 40; ++i) length += (s.node(i + 1) - s.node(i)).norm();
+  for (int i = 0; i <= 40; ++i) lowest = std::min(lowest, s.node(i).z());
+  // Chords of a curve of length L are shorter than L by O(L0^2 kappa^2 / 24) each.
+  EXPECT_NEAR(length, 100, 0.05);
+  EXPECT_LT(length, 100);
+  EXPECT_LT(lowest, -10);  // it sags
+  EXPECT_EQ((s.node(0) - s.ends.a.pos).norm(), 0);
+  EXPECT_EQ((s.node(40) - s.ends.b.pos).norm(), 0);
+  // Every node lies in the vertical plane through both ends.
+  const Vec3 normal = Vec3(60, 30, 0).cross(Vec3::UnitZ()).normalized();
+  for (int i = 0; i <= 40; ++i) EXPECT_NEAR(s.node(i).dot(normal), 0, 1e-9);
+}
+
+TEST(InitialShape, VerticalEndsHangAU) {
+  Environment env;
+  Sim s(Make(CatenaryParams(20), env));
+  s.ends.a.pos = Vec3(0, 0, 0);
+  s.ends.b.pos = Vec3(0, 0, -10);
+  s.Init();
+  for (double xi : s.x) ASSERT_TRUE(std::isfinite(xi));
+  double lowest = 0;
+  for (int i = 0; i <= 20; ++i) lowest = std::min(lowest, s.node(i).z());
+  // A U of length 100 between points 10 m apart vertically bottoms out 55 m below A.
+  EXPECT_NEAR(lowest, -55, 2.5);  // the node spacing (5 m) limits how close a node gets
+}
+
+// Static elastic catenary between two fixed points against Irvine's closed form. The lumped
+// model carries the support force as the end segment's tension plus the end node's weight,
+// which is n(0) of the continuum to O(L0^2): 0.5% at 40 segments (the target).
+TEST(Catenary, EndTensionsMatchIrvineAt40Segments) {
+  Environment env;  // dry: weight only
+  Sim s(Make(CatenaryParams(40), env));
+  s.ends.a.pos = Vec3(0, 0, 0);
+  s.ends.b.pos = Vec3(80, 0, 20);
+  s.Init();
+  // Backward Euler at a large step damps every mode: a static solve by time stepping.
+  for (int k = 0; k < 3000; ++k) ASSERT_TRUE(s.Step(0.05).ok);
+  const double w = 1.0 * 9.81;
+  testing::Catenary ref = testing::SolveCatenary(80, 20, 100, w, 1e5);
+  EndReactions r = s.Reactions();
+  EXPECT_NEAR(r.tension_a / ref.tension_a(), 1, 0.005);
+  EXPECT_NEAR(r.tension_b / ref.tension_b(), 1, 0.005);
+  // Global equilibrium holds exactly: the supports carry the whole weight.
+  EXPECT_NEAR(r.force_a.z() + r.force_b.z(), -w * 100, 1e-6 * w * 100);
+  // Force on A is n(0): horizontal component H, pulling towards B.
+  EXPECT_NEAR(r.force_a.x() / ref.H, 1, 0.005);
+}
+
+// A line hanging from one point with a free end stretches by w L^2 / (2 EA).
+TEST(Catenary, FreeHangingLineStretchesByOwnWeight) {
+  Environment env;
+  TetherParams p = CatenaryParams(20);
+  p.free_end = true;
+  Sim s(Make(p, env));
+  s.Init();
+  for (int k = 0; k < 2000; ++k) ASSERT_TRUE(s.Step(0.05).ok);
+  const double w = 9.81, L = 100, EA = 1e5;
+  // Lumped: segment j carries the weight of the nodes below it exactly, so the discrete
+  // stretch is sum_j w (L - (j + 1/2) L0) L0 / EA ... = w L^2 / (2 EA) exactly.
+  EXPECT_NEAR(-s.node(20).z(), L + w * L * L / (2 * EA), 1e-6 * L);
+}
+
+// Internal forces (tension, damping, bending with pinned ends) are action-reaction pairs:
+// they sum to zero and have no net moment (Newton's third law and the moment balance used to
+// derive the bending shear).
+TEST(Forces, InternalForcesHaveNoNetForceOrMoment) {
+  Environment env;
+  env.gravity.setZero();
+  TetherParams p = CatenaryParams(12);
+  p.EI = 50;
+  Tether t = Make(p, env);
+  ASSERT_TRUE(t.params().effects & kBending);
+  std::mt19937 rng(7);
+  std::normal_distribution<double> N(0, 1);
+  std::vector<double> x(3 * 13), v(3 * 13), f(3 * 13), work(t.WorkspaceSize());
+  for (int i = 0; i <= 12; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      x[3 * i + c] = (c == 0 ? 9.0 * i : 0.0) + N(rng);  // taut-ish, crooked
+      v[3 * i + c] = N(rng);
+    }
+  }
+  Ends ends;
+  t.ComputeForces(x.data(), v.data(), ends, f.data(), nullptr, work.data());
+  Vec3 F = Vec3::Zero(), Mo = Vec3::Zero();
+  double scale = 0;
+  for (int i = 0; i <= 12; ++i) {
+    Vec3 fi(&f[3 * i]), xi(&x[3 * i]);
+    F += fi;
+    Mo += xi.cross(fi);
+    scale += fi.norm() * (1 + xi.norm());
+  }
+  EXPECT_LT(F.norm(), 1e-12 * scale);
+  EXPECT_LT(Mo.norm(), 1e-12 * scale);
+}
+
+// Drag only removes energy: the power of the drag forces on a moving tether in still water is
+// never positive.
+TEST(Forces, DragPowerIsNeverPositive) {
+  Environment env;
+  env.wet = true;
+  env.gravity.setZero();
+  TetherParams p = CatenaryParams(10);
+  p.Cdn = 1.2;
+  p.Cdt = 0.01;
+  p.length = 1000;  // all segments slack below: only drag acts
+  Tether t = Make(p, env, "axial,drag");
+  std::mt19937 rng(3);
+  std::normal_distribution<double> N(0, 1);
+  std::vector<double> x(33), v(33), f(33), work(t.WorkspaceSize());
+  for (int trial = 0; trial < 100; ++trial) {
+    for (int i = 0; i < 33; ++i) {
+      x[i] = 10 * N(rng);
+      v[i] = N(rng);
+    }
+    t.ComputeForces(x.data(), v.data(), Ends{}, f.data(), nullptr, work.data());
+    double power = 0;
+    for (int i = 0; i < 33; ++i) power += f[i] * v[i];
+    ASSERT_LE(power, 0);
+  }
+}
+
+// Coincident nodes (zero-length segments) give finite forces and a finite step.
+TEST(Forces, CoincidentNodesStayFinite) {
+  Environment env;
+  env.wet = true;
+  env.water.current = Vec3(0.5, 0, 0);
+  TetherParams p = CatenaryParams(8);
+  p.EI = 1;
+  p.Cdn = 1.2;
+  p.Cdt = 0.01;
+  p.Can = 1;
+  for (Integrator integrator : {Integrator::kExplicit, Integrator::kImplicit}) {
+    p.integrator = integrator;
+    Sim s(Make(p, env));
+    std::fill(s.x.begin(), s.x.end(), 0.0);
+    std::fill(s.v.begin(), s.v.end(), 0.0);
+    EXPECT_TRUE(s.Step(0.01).ok);
+    for (double xi : s.x) ASSERT_TRUE(std::isfinite(xi));
+  }
+}
+
+// With no damping and no drag, the explicit (symplectic) integrator keeps the total energy of
+// a swinging tether bounded: symplectic Euler conserves a shadow energy within O(h), so the
+// deviation is a fraction of the swing energy, does not grow, and returns at the end.
+TEST(Energy, ExplicitUndampedSwingIsBounded) {
+  Environment env;  // dry, gravity
+  TetherParams p = CatenaryParams(20);
+  p.damping = 0;
+  p.integrator = Integrator::kExplicit;
+  Sim s(Make(p, env));
+  s.ends.a.pos = Vec3(0, 0, 0);
+  s.ends.b.pos = Vec3(80, 0, 0);
+  s.Init();
+  // Swing energy: start the catenary rotated 30 degrees about the chord, at rest.
+  const double E_rest = s.Energy();
+  const Eigen::AngleAxisd R(30 * M_PI / 180, Vec3::UnitX());
+  for (int i = 0; i <= 20; ++i) {
+    Vec3 r = R * s.node(i);
+    for (int c = 0; c < 3; ++c) s.x[3 * i + c] = r[c];
+  }
+  const double E0 = s.Energy(), swing = E0 - E_rest;
+  ASSERT_GT(swing, 0);
+  // About 12 swing periods (T ~ 2 pi sqrt(sag/g) ~ 8 s for ~ 25 m of sag... measured below).
+  double max_dev = 0, z_prev = 0;
+  int crossings = 0;
+  for (int k = 0; k < 10000; ++k) {
+    ASSERT_TRUE(s.Step(0.01).ok);
+    max_dev = std::max(max_dev, std::abs(s.Energy() - E0));
+    const double y = s.node(10).y();
+    if (k > 0 && (y > 0) != (z_prev > 0)) ++crossings;
+    z_prev = y;
+  }
+  EXPECT_GE(crossings, 20);  // it really swung, at least 10 periods
+  EXPECT_LT(max_dev, 0.02 * swing);
+}
+
+// The implicit integrator is dissipative: energy never rises above its start.
+TEST(Energy, ImplicitUndampedSwingNeverGainsEnergy) {
+  Environment env;
+  TetherParams p = CatenaryParams(20);
+  p.damping = 0;
+  Sim s(Make(p, env));
+  s.ends.a.pos = Vec3(0, 0, 0);
+  s.ends.b.pos = Vec3(80, 0, 0);
+  s.Init();
+  const Eigen::AngleAxisd R(30 * M_PI / 180, Vec3::UnitX());
+  for (int i = 0; i <= 20; ++i) {
+    Vec3 r = R * s.node(i);
+    for (int c = 0; c < 3; ++c) s.x[3 * i + c] = r[c];
+  }
+  const double E0 = s.Energy();
+  double E_prev = E0;
+  for (int k = 0; k < 2000; ++k) {
+    ASSERT_TRUE(s.Step(0.005).ok);
+    const double E = s.Energy();
+    ASSERT_LE(E, E0 + 1e-9 * std::abs(E0));
+    E_prev = E;
+  }
+  EXPECT_LT(E_prev, E0);
+}
+
+// The explicit stability limit is real: stepping at 0.9x the advertised limit is stable and
+// at 3x it blows up, which the divergence check reports.
+TEST(Stability, ExplicitLimitSeparatesStableFromUnstable) {
+  Environment env;
+  TetherParams p = CatenaryParams(20);
+  p.integrator = Integrator::kExplicit;
+  Tether t = Make(p, env);
+  const double limit = t.ExplicitStableStep();
+  for (double factor : {0.9, 3.0}) {
+    TetherParams q = p;
+    q.max_step = factor * limit;
+    Sim s(Make(q, env));
+    s.ends.a.pos = Vec3(0, 0, 0);
+    s.ends.b.pos = Vec3(80, 0, 20);
+    s.Init();
+    bool ok = true;
+    for (int k = 0; k < 400 && ok; ++k) ok = s.Step(20 * factor * limit).ok;
+    EXPECT_EQ(ok, factor < 1) << "factor " << factor << ", limit " << limit;
+  }
+}
+
+}  // namespace
+}  // namespace mjtether
