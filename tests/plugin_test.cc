@@ -1,1 +1,368 @@
-int main(){return 0;}
+// Tests through MuJoCo: models written inline, compared with closed forms.
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
+
+#include "catenary_reference.h"
+#include "mjtether.h"
+
+namespace mjtether {
+namespace {
+
+// A passive callback installed before mjtether, which mjtether must keep calling.
+int g_previous_calls = 0;
+void CountingPassive(const mjModel*, mjData*) { ++g_previous_calls; }
+const bool g_installed_before = (mjcb_passive = CountingPassive, true);
+
+// MuJoCo warnings fail the test that triggers them; errors abort it with the message.
+void FailOnWarning(const char* message) { ADD_FAILURE() << "MuJoCo warning: " << message; }
+void AbortOnError(const char* message) {
+  std::fprintf(stderr, "MuJoCo error: %s\n", message);
+  std::abort();
+}
+
+class MuJoCoTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    mju_user_warning = FailOnWarning;
+    mju_user_error = AbortOnError;
+  }
+  void TearDown() override {
+    for (mjData* d : datas_) mj_deleteData(d);
+    for (mjModel* m : models_) {
+      Detach(m);
+      mj_deleteModel(m);
+    }
+  }
+  mjModel* Load(const std::string& xml, const std::string& name = "test.xml") {
+    std::string error;
+    mjModel* m = LoadModelFromString(xml, name, &error);
+    EXPECT_NE(m, nullptr) << error;
+    if (m) models_.push_back(m);
+    return m;
+  }
+  mjData* Make(mjModel* m) {
+    mjData* d = mj_makeData(m);
+    datas_.push_back(d);
+    return d;
+  }
+  std::vector<mjModel*> models_;
+  std::vector<mjData*> datas_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Models
+
+// A tether between two fixed sites in air.
+std::string CatenaryXml(int segments) {
+  std::ostringstream s;
+  s << R"(<mujoco><option timestep="0.05"/><custom>
+      <text name="tether:line" data="ends=a,b length=100 segments=)"
+    << segments << R"( diameter=0.02 mass_per_length=1 EA=1e5 damping=2e3"/>
+    </custom><worldbody><site name="a" pos="0 0 0"/><site name="b" pos="80 0 20"/>
+    </worldbody></mujoco>)";
+  return s.str();
+}
+
+// A point-mass pendulum: a 10 kg sphere on a 2 m tether of 20 g, released at theta0.
+const double kPendulumL = 2, kPendulumM = 10, kPendulumEA = 1e5, kPendulumMu = 0.01;
+std::string PendulumXml(const std::string& integrator, double theta0) {
+  std::ostringstream s;
+  s.precision(17);
+  s << R"(<mujoco><option timestep="0.001" integrator=")" << integrator << R"("/>
+    <custom><text name="tether:string" data="ends=pivot,hook length=)" << kPendulumL
+    << R"( segments=10 diameter=0.005 mass_per_length=)" << kPendulumMu << " EA=" << kPendulumEA
+    << R"( damping=5"/></custom>
+    <worldbody><site name="pivot" pos="0 0 0"/>
+      <body name="bob" pos=")" << kPendulumL * std::sin(theta0) << " 0 "
+    << -kPendulumL * std::cos(theta0) << R"(">
+        <freejoint/><geom type="sphere" size="0.05" mass=")" << kPendulumM << R"("/>
+        <site name="hook"/>
+      </body></worldbody></mujoco>)";
+  return s.str();
+}
+
+// Period from upward zero crossings of the bob's x, linearly interpolated.
+double MeasurePeriod(const mjModel* m, mjData* d, double duration, int* crossings) {
+  std::vector<double> times;
+  double x_prev = d->xpos[3], t_prev = d->time;
+  while (d->time < duration) {
+    mj_step(m, d);
+    const double x = d->xpos[3];
+    if (x_prev < 0 && x >= 0) times.push_back(t_prev + (d->time - t_prev) * -x_prev / (x - x_prev));
+    x_prev = x;
+    t_prev = d->time;
+  }
+  *crossings = static_cast<int>(times.size());
+  if (times.size() < 2) return 0;
+  return (times.back() - times.front()) / (times.size() - 1);
+}
+
+// ---------------------------------------------------------------------------------------------
+
+// Elastic catenary between two fixed sites: end tensions within 0.5% of Irvine's closed form
+// at 40 segments (the lumped model's end force is n(0) to O(L0^2); measured 0.1%).
+TEST_F(MuJoCoTest, CatenaryEndTensionsMatchIrvine) {
+  mjModel* m = Load(CatenaryXml(40));
+  mjData* d = Make(m);
+  for (int k = 0; k < 3000; ++k) mj_step(m, d);
+  mj_forward(m, d);
+  ASSERT_FALSE(CheckDivergence(m, d));
+  const testing::Catenary ref = testing::SolveCatenary(80, 20, 100, 9.81, 1e5);
+  const EndReactions r = GetReactions(m, d, 0);
+  EXPECT_NEAR(r.tension_a / ref.tension_a(), 1, 0.005);
+  EXPECT_NEAR(r.tension_b / ref.tension_b(), 1, 0.005);
+}
+
+// A mass hanging on a vertical tether: static stretch (M g L + w L^2 / 2) / EA, exact for the
+// lumped model too (each segment carries what hangs below it).
+TEST_F(MuJoCoTest, HangingMassStretch) {
+  const double M = 100, L = 10, EA = 1e6, mu = 0.1, g = 9.81;
+  mjModel* m = Load(R"(<mujoco><option timestep="0.002"/><custom>
+      <text name="tether:t" data="ends=top,hook length=10 segments=20 diameter=0.01
+            mass_per_length=0.1 EA=1e6 damping=100"/></custom>
+    <worldbody><site name="top" pos="0 0 0"/>
+      <body name="load" pos="0 0 -10"><joint type="slide" axis="0 0 1" damping="4000"/>
+        <geom type="sphere" size="0.1" mass="100"/><site name="hook"/></body>
+    </worldbody></mujoco>)");
+  mjData* d = Make(m);
+  for (int k = 0; k < 5000; ++k) mj_step(m, d);
+  const double stretch = (M * g * L + mu * g * L * L / 2) / EA;
+  const double z = d->xpos[3 * 1 + 2];
+  // Joint damping settles the 10 s run to well below 1e-3 of the stretch.
+  EXPECT_NEAR(-z - L, stretch, 1e-3 * stretch);
+  EXPECT_NEAR(GetReactions(m, d, 0).tension_a, M * g + mu * g * L, 1e-3 * M * g);
+}
+
+// Pendulum period 2 pi sqrt((L + M g L/EA) / g) (1 + theta0^2/16) through each MuJoCo
+// integrator. The bob is a point mass (the tether acts through its centre); the tether's own
+// mass is 0.2% of the bob's and shortens the period by ~ m/(12 M) = 0.02%; the amplitude
+// series is exact to O(theta0^4) = 3e-6. 0.2% bounds all of it with margin.
+class PendulumTest : public MuJoCoTest, public ::testing::WithParamInterface<const char*> {};
+
+TEST_P(PendulumTest, PeriodMatchesClosedForm) {
+  const double theta0 = 5 * M_PI / 180, g = 9.81;
+  mjModel* m = Load(PendulumXml(GetParam(), theta0));
+  mjData* d = Make(m);
+  int crossings = 0;
+  const double period = MeasurePeriod(m, d, 15, &crossings);
+  ASSERT_GE(crossings, 4);
+  ASSERT_FALSE(CheckDivergence(m, d));
+  const double L = kPendulumL + kPendulumM * g * kPendulumL / kPendulumEA;
+  const double expected = 2 * M_PI * std::sqrt(L / g) * (1 + theta0 * theta0 / 16);
+  EXPECT_NEAR(period / expected, 1, 0.002) << "period " << period << " expected " << expected;
+}
+
+INSTANTIATE_TEST_SUITE_P(Integrators, PendulumTest,
+                         ::testing::Values("Euler", "implicit", "RK4"));
+
+// Euler, implicit and RK4 give the same trajectory: after 3 s (about one period) the bob's
+// positions agree to 1 mm, the size of the O(h) difference between the schemes at h = 1 ms.
+TEST_F(MuJoCoTest, IntegratorsAgree) {
+  std::vector<Vec3> end;
+  for (const char* integrator : {"Euler", "implicit", "RK4"}) {
+    mjModel* m = Load(PendulumXml(integrator, 20 * M_PI / 180));
+    mjData* d = Make(m);
+    while (d->time < 3) mj_step(m, d);
+    end.emplace_back(d->xpos[3], d->xpos[4], d->xpos[5]);
+  }
+  EXPECT_LT((end[0] - end[1]).norm(), 1e-3);
+  EXPECT_LT((end[0] - end[2]).norm(), 1e-3);
+}
+
+// The default scene, to exercise every effect together.
+std::string DefaultModel() {
+  std::ifstream f(std::string(MJTETHER_MODELS_DIR) + "/rov_tether.xml");
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+// mj_copyData carries the tether: a copy stepped on reproduces the original bit for bit.
+TEST_F(MuJoCoTest, CopyDataRolloutIsBitForBit) {
+  mjModel* m = Load(DefaultModel());
+  mjData* d = Make(m);
+  for (int k = 0; k < 250; ++k) mj_step(m, d);
+  mjData* copy = Make(m);
+  mj_copyData(copy, m, d);
+  for (int k = 0; k < 250; ++k) {
+    mj_step(m, d);
+    mj_step(m, copy);
+  }
+  EXPECT_EQ(std::memcmp(d->qpos, copy->qpos, sizeof(mjtNum) * m->nq), 0);
+  EXPECT_EQ(std::memcmp(d->qvel, copy->qvel, sizeof(mjtNum) * m->nv), 0);
+  EXPECT_EQ(std::memcmp(d->userdata, copy->userdata, sizeof(mjtNum) * m->nuserdata), 0);
+}
+
+// mj_resetData re-initialises the tether from its declared shape: a run after a reset
+// reproduces the first run bit for bit.
+TEST_F(MuJoCoTest, ResetReproducesTheRun) {
+  mjModel* m = Load(DefaultModel());
+  mjData* d = Make(m);
+  for (int k = 0; k < 200; ++k) mj_step(m, d);
+  std::vector<mjtNum> qpos(d->qpos, d->qpos + m->nq);
+  std::vector<mjtNum> user(d->userdata, d->userdata + m->nuserdata);
+  mj_resetData(m, d);
+  for (int k = 0; k < 200; ++k) mj_step(m, d);
+  EXPECT_EQ(std::memcmp(qpos.data(), d->qpos, sizeof(mjtNum) * m->nq), 0);
+  EXPECT_EQ(std::memcmp(user.data(), d->userdata, sizeof(mjtNum) * m->nuserdata), 0);
+}
+
+// A second evaluation at the same time (mj_forward again, as RK4 and user code do) changes
+// neither the tether state nor the forces.
+TEST_F(MuJoCoTest, SecondCallAtSameTimeChangesNothing) {
+  mjModel* m = Load(DefaultModel());
+  mjData* d = Make(m);
+  for (int k = 0; k < 100; ++k) mj_step(m, d);
+  mj_forward(m, d);
+  std::vector<mjtNum> user(d->userdata, d->userdata + m->nuserdata);
+  std::vector<mjtNum> passive(d->qfrc_passive, d->qfrc_passive + m->nv);
+  mj_forward(m, d);
+  EXPECT_EQ(std::memcmp(user.data(), d->userdata, sizeof(mjtNum) * m->nuserdata), 0);
+  EXPECT_EQ(std::memcmp(passive.data(), d->qfrc_passive, sizeof(mjtNum) * m->nv), 0);
+}
+
+// Going back in time (the user rewinds d->time) starts again from the initial shape.
+TEST_F(MuJoCoTest, EarlierTimeReinitialises) {
+  mjModel* m = Load(DefaultModel());
+  mjData* fresh = Make(m);
+  mj_forward(m, fresh);
+  mjData* d = Make(m);
+  for (int k = 0; k < 100; ++k) mj_step(m, d);
+  mj_resetData(m, d);  // qpos back at the start...
+  mj_forward(m, d);
+  const int n = GetTether(m, 0)->nodes();
+  EXPECT_EQ(std::memcmp(NodePositions(m, fresh, 0), NodePositions(m, d, 0), 3 * n * 8), 0);
+  for (int k = 0; k < 100; ++k) mj_step(m, d);
+  d->time = 0.05;  // ...and time set back by hand, state kept
+  mj_forward(m, d);
+  EXPECT_EQ(TetherTime(m, d, 0), 0.05);
+}
+
+// The vehicle feels the tether: in the default scene the ROV, released with the tether
+// slack, sinks until the tether catches it; without the tether it would fall 28 m to the
+// seabed. Its distance from the TMS never exceeds the tether length by more than the
+// elastic stretch (tension / EA < 1% here), and the tether is taut at the end.
+TEST_F(MuJoCoTest, DefaultSceneTetherCatchesTheVehicle) {
+  mjModel* m = Load(DefaultModel());
+  mjData* d = Make(m);
+  const int a = mj_name2id(m, mjOBJ_SITE, "tms_port"), b = mj_name2id(m, mjOBJ_SITE, "rov_attach");
+  double max_distance = 0, max_tension = 0;
+  while (d->time < 10) {
+    mj_step(m, d);
+    ASSERT_FALSE(CheckDivergence(m, d)) << *CheckDivergence(m, d);
+    Vec3 pa(d->site_xpos + 3 * a), pb(d->site_xpos + 3 * b);
+    max_distance = std::max(max_distance, (pb - pa).norm());
+    max_tension = std::max(max_tension, GetReactions(m, d, 0).tension_b);
+  }
+  EXPECT_LT(max_distance, 20 * (1 + max_tension / 2e5) + 0.05);
+  EXPECT_GT(max_distance, 19);  // it did pull the tether straight
+  EXPECT_GT(GetReactions(m, d, 0).tension_b, 100);  // holding ~400 N of wet weight, swinging
+  EXPECT_GT(g_previous_calls, 0);  // the callback installed before mjtether still runs
+}
+
+// Two models stepped alternately give the same results as each stepped alone: no state is
+// shared between models.
+TEST_F(MuJoCoTest, TwoModelsDoNotShareState) {
+  mjModel* m1 = Load(DefaultModel(), "one.xml");
+  mjModel* m2 = Load(PendulumXml("Euler", 0.3), "two.xml");
+  mjData* d1 = Make(m1);
+  mjData* d2 = Make(m2);
+  for (int k = 0; k < 300; ++k) {
+    mj_step(m1, d1);
+    mj_step(m2, d2);
+  }
+  mjData* alone = Make(m2);
+  for (int k = 0; k < 300; ++k) mj_step(m2, alone);
+  EXPECT_EQ(std::memcmp(alone->qpos, d2->qpos, sizeof(mjtNum) * m2->nq), 0);
+}
+
+// Bad declarations name the file, the element and the key.
+TEST_F(MuJoCoTest, MissingSiteIsReported) {
+  std::string error;
+  mjModel* m = LoadModelFromString(
+      R"(<mujoco><custom><text name="tether:t" data="ends=a,nowhere length=1 segments=2
+          diameter=0.01 mass_per_length=0.1 EA=1e3"/></custom>
+        <worldbody><site name="a"/></worldbody></mujoco>)",
+      "bad.xml", &error);
+  EXPECT_EQ(m, nullptr);
+  EXPECT_NE(error.find("bad.xml"), std::string::npos) << error;
+  EXPECT_NE(error.find("tether:t"), std::string::npos) << error;
+  EXPECT_NE(error.find("'ends'"), std::string::npos) << error;
+  EXPECT_NE(error.find("nowhere"), std::string::npos) << error;
+}
+
+TEST_F(MuJoCoTest, OutOfRangeValueIsReported) {
+  std::string error;
+  mjModel* m = LoadModelFromString(
+      R"(<mujoco><custom><text name="tether:t" data="ends=a,b length=1 segments=2
+          diameter=0.01 mass_per_length=0.1 EA=nan"/></custom>
+        <worldbody><site name="a"/><site name="b" pos="1 0 0"/></worldbody></mujoco>)",
+      "nan.xml", &error);
+  EXPECT_EQ(m, nullptr);
+  EXPECT_NE(error.find("nan.xml: <text name=\"tether:t\">: key 'EA'"), std::string::npos)
+      << error;
+}
+
+// The command line: a bad file exits with code 2 and names file, tether and key; a good
+// one writes the documented columns at the requested rate.
+int RunCli(const std::string& args, std::string* output) {
+  const std::string out = ::testing::TempDir() + "/cli_output.txt";
+  const int status = std::system((std::string(MJTETHER_CLI) + " " + args + " > " + out +
+                                  " 2>&1 < /dev/null").c_str());
+  std::ifstream f(out);
+  std::stringstream s;
+  s << f.rdbuf();
+  *output = s.str();
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST(Cli, BadDeclarationExitsWithCode2) {
+  const std::string path = ::testing::TempDir() + "/bad_segments.xml";
+  std::ofstream(path) << R"(<mujoco><custom><text name="tether:u" data="ends=a,b length=1
+      segments=0 diameter=0.01 mass_per_length=0.1 EA=1e3"/></custom>
+      <worldbody><site name="a"/><site name="b" pos="1 0 0"/></worldbody></mujoco>)";
+  std::string output;
+  EXPECT_EQ(RunCli("run " + path + " --duration 1", &output), 2);
+  EXPECT_NE(output.find(path), std::string::npos) << output;
+  EXPECT_NE(output.find("tether:u"), std::string::npos) << output;
+  EXPECT_NE(output.find("'segments'"), std::string::npos) << output;
+  EXPECT_NE(output.find("[1, 100000]"), std::string::npos) << output;
+}
+
+TEST(Cli, RunWritesLogColumnsAtTheRequestedRate) {
+  const std::string log = ::testing::TempDir() + "/log.csv";
+  const std::string nodes = ::testing::TempDir() + "/nodes.csv";
+  std::string output;
+  ASSERT_EQ(RunCli("run " + std::string(MJTETHER_MODELS_DIR) + "/rov_tether.xml --duration 1 "
+                   "--every 0.1 --log " + log + " --nodes " + nodes, &output),
+            0)
+      << output;
+  std::ifstream f(log);
+  std::string header, line;
+  std::getline(f, header);
+  EXPECT_EQ(header,
+            "time,rov.x,rov.y,rov.z,umbilical.tension_A,umbilical.tension_B,"
+            "umbilical.tension_max,umbilical.slack_segments");
+  std::vector<double> times;
+  while (std::getline(f, line)) times.push_back(std::stod(line));
+  ASSERT_EQ(times.size(), 11u);  // t = 0, 0.1, ..., 1.0
+  for (size_t k = 0; k < times.size(); ++k) EXPECT_NEAR(times[k], 0.1 * k, 1e-9);
+  std::ifstream g(nodes);
+  std::getline(g, header);
+  EXPECT_EQ(header, "time,tether,node,x,y,z,tension");
+  int rows = 0;
+  while (std::getline(g, line)) ++rows;
+  EXPECT_EQ(rows, 11 * 41);
+}
+
+}  // namespace
+}  // namespace mjtether
