@@ -1,222 +1,31 @@
-// mjtether: the command-line tool.
-//
-//   mjtether run MODEL.xml --duration S [--log FILE.csv] [--nodes FILE.csv] [--every S]
-//   mjtether info MODEL.xml
+// mjtether: the command-line tool. Each sub-command lives in its own plugin/cli_*.cc and
+// registers itself (cli_command.h).
 //
 // Exit codes: 0 success, 1 the simulation diverged, 2 bad input (model, declaration or
-// options), 3 MuJoCo error.
-#include <chrono>
-#include <cmath>
-#include <cstdio>
-#include <fstream>
-#include <iostream>
-#include <string>
+// options), 3 MuJoCo error, 4 an external tool failed.
+#include <functional>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-
-#include "declaration.h"
+#include "cli_command.h"
 #include "mjtether.h"
-
-namespace {
-
-struct RunOptions {
-  std::string model;
-  double duration = 0;
-  std::string log;
-  std::string nodes;
-  double every = 0.1;
-};
-
-// Bodies with a free joint: the vehicles whose position the log records.
-std::vector<int> FreeBodies(const mjModel* m) {
-  std::vector<int> bodies;
-  for (int j = 0; j < m->njnt; ++j) {
-    if (m->jnt_type[j] == mjJNT_FREE) bodies.push_back(m->jnt_bodyid[j]);
-  }
-  return bodies;
-}
-
-std::string BodyName(const mjModel* m, int b) {
-  const char* name = mj_id2name(m, mjOBJ_BODY, b);
-  return name && *name ? name : "body" + std::to_string(b);
-}
-
-int Run(const RunOptions& opt) {
-  std::string error;
-  mjModel* m = mjtether::LoadModel(opt.model, &error);
-  if (!m) {
-    std::cerr << "mjtether: " << error << "\n";
-    return 2;
-  }
-  mjData* d = mj_makeData(m);
-  const double h = m->opt.timestep;
-  const std::vector<int> bodies = FreeBodies(m);
-  const int ntether = mjtether::TetherCount(m);
-
-  std::ofstream log, nodes;
-  if (!opt.log.empty()) {
-    log.open(opt.log);
-    if (!log) {
-      std::cerr << "mjtether: cannot write --log " << opt.log << "\n";
-      return 2;
-    }
-    log << "time";
-    for (int b : bodies) {
-      const std::string n = BodyName(m, b);
-      log << "," << n << ".x," << n << ".y," << n << ".z";
-    }
-    for (int k = 0; k < ntether; ++k) {
-      const std::string n = mjtether::TetherName(m, k);
-      log << "," << n << ".tension_A," << n << ".tension_B," << n << ".tension_max," << n
-          << ".slack_segments";
-    }
-    log << "\n";
-  }
-  if (!opt.nodes.empty()) {
-    nodes.open(opt.nodes);
-    if (!nodes) {
-      std::cerr << "mjtether: cannot write --nodes " << opt.nodes << "\n";
-      return 2;
-    }
-    nodes << "time,tether,node,x,y,z,tension\n";
-  }
-  log.precision(9);
-  nodes.precision(9);
-
-  std::vector<double> T;
-  auto sample = [&]() {
-    mj_forward(m, d);  // brings every tether to d->time (no extra work for the next step)
-    if (log.is_open()) {
-      log << d->time;
-      for (int b : bodies) {
-        log << "," << d->xpos[3 * b] << "," << d->xpos[3 * b + 1] << "," << d->xpos[3 * b + 2];
-      }
-      for (int k = 0; k < ntether; ++k) {
-        const mjtether::EndReactions r = mjtether::GetReactions(m, d, k);
-        T.resize(mjtether::GetTether(m, k)->segments());
-        mjtether::GetTensions(m, d, k, T.data());
-        double tmax = 0;
-        int slack = 0;
-        for (double t : T) {
-          tmax = std::max(tmax, t);
-          slack += t <= 0;
-        }
-        log << "," << r.tension_a << "," << r.tension_b << "," << tmax << "," << slack;
-      }
-      log << "\n";
-    }
-    if (nodes.is_open()) {
-      for (int k = 0; k < ntether; ++k) {
-        const mjtether::Tether* t = mjtether::GetTether(m, k);
-        const double* x = mjtether::NodePositions(m, d, k);
-        T.resize(t->segments());
-        mjtether::GetTensions(m, d, k, T.data());
-        for (int i = 0; i < t->nodes(); ++i) {
-          nodes << d->time << "," << mjtether::TetherName(m, k) << "," << i << "," << x[3 * i]
-                << "," << x[3 * i + 1] << "," << x[3 * i + 2] << ","
-                << T[std::min(i, t->segments() - 1)] << "\n";
-        }
-      }
-    }
-  };
-
-  // Samples at t_k = k * every, scheduled by step index so that no time is accumulated.
-  const long long steps = std::llround(opt.duration / h);
-  const double every = std::max(opt.every, h);
-  long long next_sample = 0, sample_index = 0;
-  const auto start = std::chrono::steady_clock::now();
-  int status = 0;
-  for (long long i = 0;; ++i) {
-    if (i == next_sample) {
-      sample();
-      ++sample_index;
-      next_sample = std::llround(sample_index * every / h);
-    }
-    if (i == steps) break;
-    mj_step(m, d);
-    if (std::optional<std::string> diverged = mjtether::CheckDivergence(m, d)) {
-      std::cerr << "mjtether: " << *diverged << "\n";
-      status = 1;
-      break;
-    }
-    if (d->warning[mjWARN_BADQACC].number > 0) {
-      std::cerr << "mjtether: " << opt.model << ": MuJoCo found a bad acceleration at t = "
-                << d->time << " s and reset the simulation; reduce <option timestep> (now " << h
-                << " s) or use a stiffer-safe integrator (implicit tether, RK4 for the bodies)\n";
-      status = 1;
-      break;
-    }
-  }
-  const double wall =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (status == 0) {
-    std::cerr << "mjtether: simulated " << d->time << " s in " << wall << " s wall ("
-              << (wall > 0 ? d->time / wall : 0) << "x real time)";
-    if (!opt.log.empty()) std::cerr << "; log: " << opt.log;
-    std::cerr << "\n";
-  }
-  mj_deleteData(d);
-  mjtether::Detach(m);
-  mj_deleteModel(m);
-  return status;
-}
-
-int Info(const std::string& path) {
-  std::string error;
-  mjModel* m = mjtether::LoadModel(path, &error);
-  if (!m) {
-    std::cerr << "mjtether: " << error << "\n";
-    return 2;
-  }
-  std::cout << path << ": timestep " << m->opt.timestep << " s, "
-            << mjtether::TetherCount(m) << " tether(s)\n";
-  for (int k = 0; k < mjtether::TetherCount(m); ++k) {
-    const mjtether::Tether* t = mjtether::GetTether(m, k);
-    const mjtether::TetherParams& p = t->params();
-    std::cout << "  tether '" << mjtether::TetherName(m, k) << "': " << p.segments
-              << " segments of " << t->rest_segment_length() << " m, "
-              << (p.integrator == mjtether::Integrator::kExplicit ? "explicit" : "implicit")
-              << ", effects " << mjtether::EffectsToString(p.effects) << "\n"
-              << "    explicit stable step " << t->ExplicitStableStep() << " s; "
-              << t->SubstepsFor(m->opt.timestep) << " tether step(s) per MuJoCo step\n";
-  }
-  mjtether::Detach(m);
-  mj_deleteModel(m);
-  return 0;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   mjtether::InstallErrorHandlers();
   CLI::App app{"mjtether: lumped-mass ROV tethers in MuJoCo"};
   app.require_subcommand(1);
-
-  RunOptions run;
-  CLI::App* run_cmd = app.add_subcommand("run", "simulate a model and write its log");
-  run_cmd->add_option("model", run.model, "MJCF file declaring the tethers")
-      ->required()
-      ->check(CLI::ExistingFile);
-  run_cmd->add_option("--duration", run.duration, "simulated time [s]")
-      ->required()
-      ->check(CLI::Range(0.0, 1e7));
-  run_cmd->add_option("--log", run.log, "CSV: time, free bodies' positions, end tensions");
-  run_cmd->add_option("--nodes", run.nodes, "CSV: time,tether,node,x,y,z,tension");
-  run_cmd->add_option("--every", run.every, "sampling interval of both CSV files [s]")
-      ->check(CLI::Range(1e-9, 1e7));
-
-  std::string info_model;
-  CLI::App* info_cmd = app.add_subcommand("info", "print the tethers of a model");
-  info_cmd->add_option("model", info_model, "MJCF file")->required()->check(CLI::ExistingFile);
-
+  std::vector<std::pair<CLI::App*, std::function<int()>>> actions;
+  for (const mjtether::cli::Command& c : mjtether::cli::Commands()) {
+    CLI::App* sub = app.add_subcommand(c.name, c.help);
+    actions.emplace_back(sub, c.setup(sub));
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
     return code == 0 ? 0 : 2;
   }
-  if (*run_cmd) return Run(run);
-  if (*info_cmd) return Info(info_model);
+  for (auto& [sub, action] : actions) {
+    if (*sub) return action();
+  }
   return 2;
 }
