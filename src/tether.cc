@@ -28,10 +28,12 @@ struct Work {
   double* v2;    // 3 x n
   double* rhs;   // 3 x n   implicit right-hand side / velocity change
   double* band;  // (3 x n) x 9  implicit band matrix
+  double* xs;    // 3 x n   state saved before an implicit step, to retry it in halves
+  double* vs;    // 3 x n
   static int Size(int N) {
     const int n = N + 1;
     return 3 * n + 3 * N + N + N + 3 * n + 3 * n + 3 * n + 3 * n + 3 * n +
-           BandMatrix::Size(3 * n, 8);
+           BandMatrix::Size(3 * n, 8) + 6 * n;
   }
   Work(double* w, int N) {
     const int n = N + 1;
@@ -45,6 +47,8 @@ struct Work {
     v2 = x2 + 3 * n;
     rhs = v2 + 3 * n;
     band = rhs + 3 * n;
+    xs = band + BandMatrix::Size(3 * n, 8);
+    vs = xs + 3 * n;
   }
 };
 
@@ -486,13 +490,14 @@ void Tether::ExplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
 // smooth forces one iteration suffices. The tension-only law is not smooth: a segment that
 // changes between slack and taut during the step invalidates the linearisation, so the
 // iteration repeats (at most kMaxNewton times) until the set of taut segments settles.
+// Returns false if it did not settle (the caller then retries the step in two halves).
 //
 // K holds the axial stiffness EA/L0 t t^T + T/l (I - t t^T) of taut segments, the small-angle
 // bending stiffness EI/w g g^T (g the second-difference stencil of the curvature), and the
 // seabed stiffness; D the axial damping, the drag and seabed damping, and the secant of the
 // friction. Every block is symmetric and K <= 0, D <= 0, so the matrix is SPD and banded
 // (3x3 blocks, two off-diagonals with bending, one without): a band Cholesky solves it.
-void Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
+bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
                           double* work) const {
   (void)now;
   constexpr int kMaxNewton = 4;
@@ -513,7 +518,7 @@ void Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   if (nu == 0) {
     x = xk;
     v = vk;
-    return;
+    return true;
   }
   ConstNodes f(w.f, 3, n), t(w.t, 3, N_), q(w.q, 3, n);
   const int band_p = Has(kBending) ? 8 : 5;
@@ -535,7 +540,8 @@ void Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
     }
   };
 
-  for (int iter = 0; iter < kMaxNewton; ++iter) {
+  bool settled = false;
+  for (int iter = 0; iter < kMaxNewton && !settled; ++iter) {
     ComputeForces(w.x2, w.v2, next, w.f, w.T, work);
     A.SetZero();
     // Node mass with normal added mass; residual -G = h f - M (v+ - v).
@@ -618,6 +624,7 @@ void Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
     // Solve; a failed factorisation leaves NaN behind for the divergence check to report.
     if (A.Factor() >= 0) {
       vk.col(1).setConstant(NAN);
+      settled = true;  // nothing to retry: the divergence check reports it
       break;
     }
     A.Solve(w.rhs);
@@ -628,10 +635,30 @@ void Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
     for (int j = 0; j < N_ && !changed; ++j) {
       changed = ((xk.col(j + 1) - xk.col(j)).norm() > L0_) != (w.l[j] > L0_);
     }
-    if (!changed) break;
+    settled = !changed;
   }
   x = xk;
   v = vk;
+  return settled;
+}
+
+// An implicit step whose Newton iteration did not settle is redone as two half steps (the
+// ends at the midpoint from the same Hermite curve), down to 1/2^kMaxHalvings of the step;
+// at that depth the last iterate is accepted.
+void Tether::ImplicitStepAdaptive(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
+                                  int depth, double* work) const {
+  constexpr int kMaxHalvings = 8;
+  Work w(work, N_);
+  const int n = N_ + 1;
+  Nodes xs(w.xs, 3, n), vs(w.vs, 3, n);
+  xs = x;
+  vs = v;
+  if (ImplicitStep(x, v, now, next, h, work) || depth == kMaxHalvings) return;
+  x = xs;
+  v = vs;
+  const Ends mid = Interpolate(now, next, h, 0.5);
+  ImplicitStepAdaptive(x, v, now, mid, h / 2, depth + 1, work);
+  ImplicitStepAdaptive(x, v, mid, next, h / 2, depth + 1, work);
 }
 
 StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends& to, double dt,
@@ -654,7 +681,7 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
     if (p_.integrator == Integrator::kExplicit) {
       ExplicitStep(x, v, now, next, h, work);
     } else {
-      ImplicitStep(x, v, now, next, h, work);
+      ImplicitStepAdaptive(x, v, now, next, h, 0, work);
     }
     now = next;
   }

@@ -132,8 +132,10 @@ class Tether {
   // Integrators (one step of size h; ends already set at the start, `next` at the end).
   void ExplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
                     double* work) const;
-  void ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
+  bool ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
                     double* work) const;
+  void ImplicitStepAdaptive(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
+                            int depth, double* work) const;
 
   bool Has(unsigned effect) const { return (p_.effects & effect) != 0; }
   bool Dynamic(int i) const { return i > 0 && (i < N_ || p_.free_end); }
