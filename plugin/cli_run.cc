@@ -46,6 +46,9 @@ int Run(const RunOptions& opt) {
     std::cerr << "mjtether: " << error << "\n";
     return 2;
   }
+  for (const std::string& w : mjtether::Warnings(m)) {
+    std::cerr << "mjtether: warning: " << w << "\n";
+  }
   mjData* d = mj_makeData(m);
   const double h = m->opt.timestep;
   const std::vector<int> bodies = FreeBodies(m);
@@ -125,6 +128,7 @@ int Run(const RunOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
   int status = 0;
   for (long long i = 0;; ++i) {
+    mjtether::Prescribe(m, d);  // motion: and thrust: declarations at d->time
     if (i == next_sample) {
       sample();
       ++sample_index;
@@ -165,6 +169,9 @@ int Info(const std::string& path) {
   if (!m) {
     std::cerr << "mjtether: " << error << "\n";
     return 2;
+  }
+  for (const std::string& w : mjtether::Warnings(m)) {
+    std::cerr << "mjtether: warning: " << w << "\n";
   }
   std::cout << path << ": timestep " << m->opt.timestep << " s, "
             << mjtether::TetherCount(m) << " tether(s)\n";

@@ -22,9 +22,11 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <mujoco/mujoco.h>
 
+#include "mjtether_vehicles.h"  // vehicles, prescribed motion, thrust schedules
 #include "tether.h"
 
 namespace mjtether {
@@ -45,6 +47,12 @@ bool Attach(mjModel* m, const std::string& source, std::string* error);
 
 // Forgets a model (call before mj_deleteModel). Unknown models are ignored.
 void Detach(const mjModel* m);
+
+// Warnings of the time-step advisor from Attach, one sentence each naming the file, the
+// tether, the explicit stability limit and the setting to change: an explicit tether whose
+// `substeps` or `max_step` makes its step longer than the limit. (Explicit tethers without
+// those keys substep automatically; more than 1e5 substeps per MuJoCo step is an error.)
+std::vector<std::string> Warnings(const mjModel* m);
 
 // Number of tethers attached to m, and the index of one by name (-1 if none).
 int TetherCount(const mjModel* m);

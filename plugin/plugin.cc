@@ -14,6 +14,7 @@
 
 #include "declaration.h"
 #include "mjtether.h"
+#include "vehicle_glue.h"
 
 namespace mjtether {
 namespace {
@@ -22,7 +23,7 @@ namespace {
 enum Slot : int {
   kInitialized = 0,  // 1 once the initial shape is set (mj_resetData zeroes it)
   kTime,             // [s] the tether's own time
-  kStatus,           // 0 ok, 1 non-finite, 2 strain beyond max_strain
+  kStatus,           // 0 ok, 1 non-finite, 2 strain beyond max_strain, 3 energy blow-up
   kBadNode,          // first offending node
   kBadTime,          // [s] when it diverged
   kEndA,             // pos(3) vel(3) axis(3) of end A at kTime
@@ -47,7 +48,12 @@ struct ModelTethers {
   std::vector<AttachedTether> tethers;
   int work_size = 0;  // doubles of mjData stack the callback takes
   int nuserdata = 0;  // m->nuserdata after Attach, to catch a stale registration
+  std::vector<std::string> warnings;  // time-step advisor (see Warnings in mjtether.h)
 };
+
+// More automatic explicit substeps per MuJoCo step than this is refused at load time: the
+// run would take hours per simulated second (see the time-step advisor in Attach).
+constexpr int kMaxAutoSubsteps = 100000;
 
 std::shared_mutex g_mutex;
 std::unordered_map<const mjModel*, std::unique_ptr<ModelTethers>> g_models;
@@ -76,7 +82,9 @@ EndState SiteState(const mjModel* m, const mjData* d, const AttachedTether& at, 
   e.pos = Vec3(d->site_xpos + 3 * s);
   const double* R = d->site_xmat + 9 * s;
   e.axis = Vec3(R[0], R[3], R[6]);
-  if (at.mocap[end]) {
+  if (at.mocap[end] && PrescribedVelocity(m, d, at.body[end], &e.vel)) {
+    // moved by a motion: declaration: its exact velocity
+  } else if (at.mocap[end]) {
     const double dt = d->time - u[kTime];
     if (u[kInitialized] != 0 && dt > 0) {
       e.vel = (e.pos - Vec3(stored)) / dt;
@@ -130,7 +138,9 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
     Ends from{LoadEnd(u + kEndA), LoadEnd(u + kEndB)};
     StepStatus status = tether.Advance(x, v, from, now, d->time - u[kTime], work);
     if (!status.ok) {
-      u[kStatus] = status.reason.rfind("strain", 0) == 0 ? 2 : 1;
+      u[kStatus] = status.reason.rfind("strain", 0) == 0    ? 2
+                   : status.reason.rfind("kinetic", 0) == 0 ? 3
+                                                            : 1;
       u[kBadNode] = status.node;
       u[kBadTime] = d->time;
       return;
@@ -163,6 +173,7 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
 
 void Passive(const mjModel* m, mjData* d) {
   if (g_previous_passive) g_previous_passive(m, d);
+  ApplyVehicles(m, d);  // vehicle:BODY declarations (plugin/vehicles.cc)
   const ModelTethers* set = Lookup(m);
   if (!set) return;
   mjMARKSTACK;
@@ -184,6 +195,37 @@ const double* UserBlock(const mjModel* m, const mjData* d, int k) {
   const ModelTethers* set = Lookup(m);
   if (!set || k < 0 || k >= static_cast<int>(set->tethers.size())) return nullptr;
   return d->userdata + set->tethers[k].offset;
+}
+
+// Time-step advisor for an explicit tether, from its stability limit (Tether::ExplicitStableStep,
+// highest natural frequency of the axial, bending and seabed stiffness on the lightest node).
+// A tether step fixed by `substeps` or `max_step` above the limit gets a warning naming the
+// limit and the setting to change; an automatic substep count above kMaxAutoSubsteps per
+// MuJoCo step is an error. Implicit tethers need no advice.
+bool Advise(const Tether& t, double timestep, std::string* warning, std::string* error) {
+  const TetherParams& p = t.params();
+  if (p.integrator != Integrator::kExplicit) return true;
+  const double limit = t.ExplicitStableStep();
+  const int steps = t.SubstepsFor(timestep);
+  const double h = timestep / steps;
+  std::ostringstream s;
+  if (p.substeps > 0 || p.max_step > 0) {
+    if (h <= limit) return true;
+    s << "integrator=explicit: the tether step " << h << " s ("
+      << (p.substeps > 0 ? "substeps=" + std::to_string(p.substeps) : "max_step")
+      << ") exceeds the explicit stability limit " << limit << " s; set substeps >= "
+      << static_cast<long long>(std::ceil(timestep / limit)) << " or max_step <= " << limit
+      << ", or remove both (automatic substeps), or use integrator=implicit";
+    *warning = s.str();
+    return true;
+  }
+  if (steps <= kMaxAutoSubsteps) return true;
+  s << "integrator=explicit needs " << std::ceil(timestep / limit)
+    << " substeps per MuJoCo step (stability limit " << limit << " s, <option timestep> "
+    << timestep << " s), more than " << kMaxAutoSubsteps
+    << ": use integrator=implicit, fewer segments or a smaller EA/EI";
+  *error = s.str();
+  return false;
 }
 
 }  // namespace
@@ -228,6 +270,11 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
     std::string message;
     std::optional<Tether> tether = Tether::Create(decl->params, env, &message);
     if (!tether) return fail(name, message);
+    std::string advice;
+    if (!Advise(*tether, m->opt.timestep, &advice, &message)) return fail(name, message);
+    if (!advice.empty()) {
+      set->warnings.push_back(source + ": <text name=\"" + name + "\">: " + advice);
+    }
     AttachedTether at{name.substr(7), *tether};
     const std::string sites[2] = {decl->site_a, decl->site_b};
     for (int end = 0; end < 2; ++end) {
@@ -248,7 +295,10 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
     set->work_size = std::max(set->work_size, tether->WorkspaceSize());
     set->tethers.push_back(std::move(at));
   }
-  if (set->tethers.empty()) return true;
+  // Vehicles, motions and thrust schedules (plugin/vehicles.cc) use the same callback.
+  bool vehicles = false;
+  if (!AttachVehicles(m, source, env, &vehicles, error)) return false;
+  if (set->tethers.empty() && !vehicles) return true;
   m->nuserdata = offset;
   m->nstack += set->work_size + 64;
   set->nuserdata = m->nuserdata;
@@ -265,6 +315,7 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
 }
 
 void Detach(const mjModel* m) {
+  DetachVehicles(m);
   std::unique_lock<std::shared_mutex> lock(g_mutex);
   g_models.erase(m);
 }
@@ -312,6 +363,11 @@ mjModel* LoadModelFromString(const std::string& xml, const std::string& name,
 int TetherCount(const mjModel* m) {
   const ModelTethers* set = Lookup(m);
   return set ? static_cast<int>(set->tethers.size()) : 0;
+}
+
+std::vector<std::string> Warnings(const mjModel* m) {
+  const ModelTethers* set = Lookup(m);
+  return set ? set->warnings : std::vector<std::string>();
 }
 
 int FindTether(const mjModel* m, const std::string& name) {
@@ -392,7 +448,9 @@ std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d) {
     std::ostringstream s;
     s << set->source << ": tether '" << at.name << "' diverged at t = " << u[kBadTime]
       << " s at node " << static_cast<int>(u[kBadNode]) << " of " << t.nodes() << " ("
-      << (u[kStatus] == 2 ? "strain beyond max_strain" : "non-finite position or velocity")
+      << (u[kStatus] == 2   ? "strain beyond max_strain"
+          : u[kStatus] == 3 ? "kinetic energy blow-up"
+                            : "non-finite position or velocity")
       << "). ";
     if (t.params().integrator == Integrator::kExplicit) {
       s << "The explicit integrator's stable step is " << t.ExplicitStableStep()

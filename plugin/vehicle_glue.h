@@ -1,0 +1,34 @@
+// Internal glue between plugin.cc and the vehicle, motion and thrust declarations
+// (plugin/vehicles.cc). Not part of the public API (see mjtether_vehicles.h).
+#ifndef MJTETHER_PLUGIN_VEHICLE_GLUE_H_
+#define MJTETHER_PLUGIN_VEHICLE_GLUE_H_
+
+#include <string>
+
+#include <mujoco/mujoco.h>
+
+#include "params.h"
+
+namespace mjtether {
+
+// Reads every "vehicle:", "motion:" and "thrust:" text of m, checks it, adds the vehicles'
+// added mass to the free joints' armature and registers m. *any is set when m declares at
+// least one of them. On error nothing is registered or changed; *error is
+// "SOURCE: <text name=...>: message".
+bool AttachVehicles(mjModel* m, const std::string& source, const Environment& env, bool* any,
+                    std::string* error);
+
+// Forgets m's vehicles, motions and schedules.
+void DetachVehicles(const mjModel* m);
+
+// Adds the vehicles' buoyancy, damping and added-mass remainder to d->qfrc_passive (called from
+// the passive callback). Allocates nothing.
+void ApplyVehicles(const mjModel* m, mjData* d);
+
+// The exact velocity of a body moved by a "motion:" declaration at d->time, if its mocap
+// position is the prescribed one at d->time (Prescribe was called); false otherwise.
+bool PrescribedVelocity(const mjModel* m, const mjData* d, int body, Vec3* vel);
+
+}  // namespace mjtether
+
+#endif  // MJTETHER_PLUGIN_VEHICLE_GLUE_H_

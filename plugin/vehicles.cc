@@ -1,0 +1,246 @@
+// MuJoCo 2.2 glue for vehicles (Fossen hydrodynamics on free bodies), prescribed motion of
+// mocap bodies and scripted actuator inputs.
+#include <cmath>
+#include <cstring>
+#include <memory>
+#include <mutex>
+#include <shared_mutex>
+#include <sstream>
+#include <unordered_map>
+#include <vector>
+
+#include "mjtether.h"
+#include "mjtether_vehicles.h"
+#include "vehicle_declaration.h"
+#include "vehicle_glue.h"
+
+namespace mjtether {
+namespace {
+
+struct AttachedVehicle {
+  std::string name;  // the body's name
+  int body = -1;
+  int dof = -1;      // first dof of the body's free joint
+  Vehicle vehicle;
+};
+
+struct AttachedMotion {
+  int body = -1;
+  int mocap = -1;
+  Vec3 initial = Vec3::Zero();  // [m] the body's position in the model
+  Motion motion;
+};
+
+struct AttachedSchedule {
+  int actuator = -1;
+  Schedule schedule;
+};
+
+struct ModelVehicles {
+  std::vector<AttachedVehicle> vehicles;
+  std::vector<AttachedMotion> motions;
+  std::vector<AttachedSchedule> schedules;
+};
+
+std::shared_mutex g_mutex;
+std::unordered_map<const mjModel*, std::unique_ptr<ModelVehicles>> g_models;
+
+const ModelVehicles* Lookup(const mjModel* m) {
+  std::shared_lock<std::shared_mutex> lock(g_mutex);
+  auto it = g_models.find(m);
+  return it == g_models.end() ? nullptr : it->second.get();
+}
+
+using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+
+std::string Directory(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? "" : path.substr(0, slash + 1);
+}
+
+// Relative tolerance [-] for "the mocap position is the prescribed one".
+constexpr double kSamePosition = 1e-9;
+
+}  // namespace
+
+bool AttachVehicles(mjModel* m, const std::string& source, const Environment& env, bool* any,
+                    std::string* error) {
+  *any = false;
+  std::string element;
+  auto fail = [&](const std::string& message) {
+    if (error) *error = source + ": <text name=\"" + element + "\">: " + message;
+    return false;
+  };
+  auto set = std::make_unique<ModelVehicles>();
+  for (int i = 0; i < m->ntext; ++i) {
+    element = m->names + m->name_textadr[i];
+    const std::string data = m->text_data + m->text_adr[i];
+    const size_t colon = element.find(':');
+    if (colon == std::string::npos) continue;
+    const std::string kind = element.substr(0, colon), name = element.substr(colon + 1);
+    if (kind != "vehicle" && kind != "motion" && kind != "thrust") continue;
+    if (name.empty()) return fail("a " + kind + " needs a name after '" + kind + ":'");
+    DeclarationError e;
+    if (kind == "vehicle") {
+      const int b = mj_name2id(m, mjOBJ_BODY, name.c_str());
+      if (b < 0) return fail("no body named '" + name + "' in the model");
+      const int j = m->body_jntadr[b];
+      if (m->body_jntnum[b] != 1 || m->jnt_type[j] != mjJNT_FREE) {
+        return fail("body '" + name + "' must have exactly one joint, a free joint (<freejoint/>)");
+      }
+      // MuJoCo's inertia-box / ellipsoid fluid model acts on every body when density or
+      // viscosity > 0: its drag would be counted on top of the declared damping.
+      if (m->opt.density > 0 || m->opt.viscosity > 0) {
+        std::ostringstream s;
+        s << "MuJoCo's own fluid model (<option density=\"" << m->opt.density
+          << "\" viscosity=\"" << m->opt.viscosity << "\">) would also act on body '" << name
+          << "', on top of the declared damping; set <option density=\"0\" viscosity=\"0\"> "
+             "(the water's density and current come from <text name=\"water\">)";
+        return fail(s.str());
+      }
+      std::optional<VehicleParams> p = ParseVehicle(data, &e);
+      if (!p) return fail(e.message);
+      std::string message;
+      std::optional<Vehicle> v = Vehicle::Create(*p, env, m->body_subtreemass[b], &message);
+      if (!v) return fail(message);
+      set->vehicles.push_back({name, b, m->jnt_dofadr[j], *v});
+    } else if (kind == "motion") {
+      const int b = mj_name2id(m, mjOBJ_BODY, name.c_str());
+      if (b < 0) return fail("no body named '" + name + "' in the model");
+      if (m->body_mocapid[b] < 0) {
+        return fail("body '" + name + "' is not a mocap body: declare it with mocap=\"true\"");
+      }
+      std::optional<MotionParams> p = ParseMotion(data, &e);
+      if (!p) return fail(e.message);
+      const std::string path =
+          !p->csv.empty() && p->csv[0] != '/' ? Directory(source) + p->csv : p->csv;
+      std::string message;
+      std::optional<Motion> mo = Motion::Create(*p, path, &message);
+      if (!mo) return fail(message);
+      set->motions.push_back({b, m->body_mocapid[b], Vec3(m->body_pos + 3 * b), *mo});
+    } else {
+      const int a = mj_name2id(m, mjOBJ_ACTUATOR, name.c_str());
+      if (a < 0) return fail("no actuator named '" + name + "' in the model");
+      std::optional<Schedule> s = ParseSchedule(data, &e);
+      if (!s) return fail(e.message);
+      set->schedules.push_back({a, *s});
+    }
+  }
+  *any = !set->vehicles.empty() || !set->motions.empty() || !set->schedules.empty();
+  if (!*any) return true;
+  // Added mass into the free joints' armature: world-frame translation dofs take the isotropic
+  // part, body-frame rotation dofs the rotational diagonal (see vehicle.h).
+  for (const AttachedVehicle& av : set->vehicles) {
+    for (int i = 0; i < 3; ++i) {
+      m->dof_armature[av.dof + i] += av.vehicle.armature_translation();
+      m->dof_armature[av.dof + 3 + i] += av.vehicle.armature_rotation()[i];
+    }
+  }
+  // MuJoCo 2.2 bakes the armature of "simple" dofs (a free body with its centre of mass at the
+  // origin and a diagonal inertia) into dof_M0 at compile time: recompute the constants.
+  if (!set->vehicles.empty()) {
+    mjData* scratch = mj_makeData(m);
+    mj_setConst(m, scratch);
+    mj_deleteData(scratch);
+  }
+  std::unique_lock<std::shared_mutex> lock(g_mutex);
+  g_models[m] = std::move(set);
+  return true;
+}
+
+void DetachVehicles(const mjModel* m) {
+  std::unique_lock<std::shared_mutex> lock(g_mutex);
+  g_models.erase(m);
+}
+
+void ApplyVehicles(const mjModel* m, mjData* d) {
+  const ModelVehicles* set = Lookup(m);
+  if (!set) return;
+  for (const AttachedVehicle& av : set->vehicles) {
+    const Vehicle& veh = av.vehicle;
+    const int b = av.body;
+    const Eigen::Map<const RowMat3> R(d->xmat + 9 * b);  // body to world
+    const Vec3 origin(d->xpos + 3 * b);
+    // Buoyancy at the centre of buoyancy.
+    if (veh.has_buoyancy()) {
+      const Vec3 cob = origin + R * veh.params().cob;
+      const Vec3 f = veh.Buoyancy(), zero = Vec3::Zero();
+      mj_applyFT(m, d, f.data(), zero.data(), cob.data(), b, d->qfrc_passive);
+    }
+    if (!veh.has_damping() && !veh.has_added_mass()) continue;
+    // Free joint: qvel = world velocity of the body origin, then body-frame angular velocity.
+    const Vec3 v(d->qvel + av.dof), w(d->qvel + av.dof + 3);
+    const Vec6 nu_r = veh.RelativeVelocity(R, v, w);
+    Wrench tau = veh.Damping(nu_r);
+    if (veh.has_added_mass()) {
+      // Body-frame derivative of v_r from the last computed acceleration (the lag term).
+      const Vec3 a(d->qacc + av.dof);
+      const Vec3 dv_r = R.transpose() * a - w.cross(nu_r.head<3>());
+      const Wrench am = veh.AddedMass(nu_r, dv_r);
+      tau.force += am.force;
+      tau.torque += am.torque;
+    }
+    const Vec3 f = R * tau.force, t = R * tau.torque;
+    mj_applyFT(m, d, f.data(), t.data(), origin.data(), b, d->qfrc_passive);
+  }
+}
+
+bool PrescribedVelocity(const mjModel* m, const mjData* d, int body, Vec3* vel) {
+  const ModelVehicles* set = Lookup(m);
+  if (!set || body < 0) return false;
+  const int root = m->body_rootid[body];
+  for (const AttachedMotion& am : set->motions) {
+    if (am.body != root) continue;
+    const Vec3 expected = am.initial + am.motion.Offset(d->time);
+    const Vec3 actual(d->mocap_pos + 3 * am.mocap);
+    if ((actual - expected).norm() > kSamePosition * (1 + expected.norm())) return false;
+    *vel = am.motion.Velocity(d->time);
+    return true;
+  }
+  return false;
+}
+
+void Prescribe(const mjModel* m, mjData* d) {
+  const ModelVehicles* set = Lookup(m);
+  if (!set) return;
+  for (const AttachedMotion& am : set->motions) {
+    const Vec3 p = am.initial + am.motion.Offset(d->time);
+    for (int i = 0; i < 3; ++i) d->mocap_pos[3 * am.mocap + i] = p[i];
+  }
+  for (const AttachedSchedule& as : set->schedules) {
+    d->ctrl[as.actuator] = as.schedule.At(d->time);
+  }
+}
+
+void Step(const mjModel* m, mjData* d) {
+  Prescribe(m, d);
+  mj_step(m, d);
+}
+
+int VehicleCount(const mjModel* m) {
+  const ModelVehicles* set = Lookup(m);
+  return set ? static_cast<int>(set->vehicles.size()) : 0;
+}
+
+int FindVehicle(const mjModel* m, const std::string& body_name) {
+  const ModelVehicles* set = Lookup(m);
+  if (!set) return -1;
+  for (size_t k = 0; k < set->vehicles.size(); ++k) {
+    if (set->vehicles[k].name == body_name) return static_cast<int>(k);
+  }
+  return -1;
+}
+
+int VehicleBody(const mjModel* m, int k) {
+  const ModelVehicles* set = Lookup(m);
+  if (!set || k < 0 || k >= static_cast<int>(set->vehicles.size())) return -1;
+  return set->vehicles[k].body;
+}
+
+const Vehicle* GetVehicle(const mjModel* m, int k) {
+  const ModelVehicles* set = Lookup(m);
+  if (!set || k < 0 || k >= static_cast<int>(set->vehicles.size())) return nullptr;
+  return &set->vehicles[k].vehicle;
+}
+
+}  // namespace mjtether
