@@ -1,0 +1,355 @@
+// `mjtether render`: a video (H.264 through ffmpeg) and/or PNG stills of a model, rendered
+// off-screen (plugin/render.h).
+//
+//   mjtether render MODEL.xml --duration S --video out.mp4 [--fps 30] [--size 1280x720]
+//       [--camera follow|track:BODY|NAME] [--png-every S DIR] [--samples N]
+//       [--tension-max N] [--vehicle BODY] [--no-hud]
+//
+// Frame k shows the state at step round(k / (fps h)), h the model's timestep: frames are
+// scheduled by index, so they never drift from t = k/fps by more than h/2 however long the
+// video. The video has floor(duration * fps) frames and lasts `duration` seconds.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cli_command.h"
+#include "mjtether.h"
+#include "render.h"
+
+namespace {
+
+struct RenderCliOptions {
+  std::string model;
+  double duration = 0;
+  std::string video;
+  double fps = 30;
+  std::string size = "1280x720";
+  std::string camera = "follow";
+  std::vector<std::string> png_every;  // {interval, directory}
+  int samples = 4;
+  double tension_max = 0;
+  std::string vehicle;
+  bool no_hud = false;
+};
+
+// ffmpeg reading raw RGB frames on its stdin: started with fork/exec (no shell, so any file
+// name works), closed with its exit status checked.
+class FfmpegPipe {
+ public:
+  bool Open(const std::string& out, int width, int height, double fps, std::string* error) {
+    int fds[2];
+    if (pipe(fds) != 0) {
+      *error = std::string("pipe: ") + std::strerror(errno);
+      return false;
+    }
+    const std::string size = std::to_string(width) + "x" + std::to_string(height);
+    char rate[32];
+    std::snprintf(rate, sizeof(rate), "%.9g", fps);
+    std::vector<std::string> args = {
+        "ffmpeg", "-hide_banner", "-loglevel", "error",    "-y",      "-f", "rawvideo", "-pix_fmt",
+        "rgb24",  "-s",           size,        "-r",       rate,      "-i", "-",        "-vf",
+        "vflip",  "-c:v",         "libx264",   "-pix_fmt", "yuv420p", "-r", rate,       out};
+    pid_ = fork();
+    if (pid_ < 0) {
+      *error = std::string("fork: ") + std::strerror(errno);
+      return false;
+    }
+    if (pid_ == 0) {
+      dup2(fds[0], 0);
+      close(fds[0]);
+      close(fds[1]);
+      std::vector<char*> argv;
+      for (std::string& a : args) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      execvp("ffmpeg", argv.data());
+      std::fprintf(stderr, "mjtether: cannot run ffmpeg: %s\n", std::strerror(errno));
+      _exit(127);
+    }
+    close(fds[0]);
+    fd_ = fds[1];
+    return true;
+  }
+
+  bool Write(const unsigned char* data, size_t n) {
+    while (n > 0) {
+      const ssize_t w = write(fd_, data, n);
+      if (w < 0) {
+        if (errno == EINTR) continue;
+        return false;
+      }
+      data += w;
+      n -= static_cast<size_t>(w);
+    }
+    return true;
+  }
+
+  // Closes the pipe and waits; returns ffmpeg's exit status (127: not found), or -1.
+  int Close() {
+    if (fd_ >= 0) close(fd_);
+    fd_ = -1;
+    if (pid_ <= 0) return -1;
+    int status = 0;
+    while (waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
+    }
+    pid_ = -1;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+
+  ~FfmpegPipe() { Close(); }
+
+ private:
+  int fd_ = -1;
+  pid_t pid_ = -1;
+};
+
+bool ParseSize(const std::string& s, int* w, int* h) {
+  char x = 0, extra = 0;
+  return std::sscanf(s.c_str(), "%d%c%d%c", w, &x, h, &extra) == 3 && (x == 'x' || x == 'X');
+}
+
+// Largest tension of any segment or end over the frames' instants, to fix the colour scale
+// before rendering. Returns nullopt if the simulation diverges (the message is printed).
+std::optional<double> TensionPrepass(const mjModel* m, long long nframes, double fps) {
+  mjData* d = mj_makeData(m);
+  const double h = m->opt.timestep;
+  std::vector<double> T;
+  double tmax = 0;
+  bool ok = true;
+  long long step = 0;
+  for (long long k = 0; k < nframes && ok; ++k) {
+    const long long target = mjtether::render::FrameStep(k, fps, h);
+    for (; step < target; ++step) {
+      mj_step(m, d);
+      if (std::optional<std::string> diverged = mjtether::CheckDivergence(m, d)) {
+        std::cerr << "mjtether: " << *diverged << "\n";
+        ok = false;
+        break;
+      }
+    }
+    if (!ok) break;
+    mj_forward(m, d);
+    for (int t = 0; t < mjtether::TetherCount(m); ++t) {
+      T.resize(mjtether::GetTether(m, t)->segments());
+      mjtether::GetTensions(m, d, t, T.data());
+      for (double x : T) tmax = std::max(tmax, x);
+      const mjtether::EndReactions r = mjtether::GetReactions(m, d, t);
+      tmax = std::max({tmax, r.tension_a, r.tension_b});
+    }
+  }
+  mj_deleteData(d);
+  if (!ok) return std::nullopt;
+  return tmax;
+}
+
+void Progress(long long done, long long total, double t, double elapsed) {
+  const int width = 30;
+  const int filled = static_cast<int>(width * done / std::max(1LL, total));
+  const double eta = done > 0 ? elapsed * (total - done) / done : 0;
+  std::fprintf(stderr, "\r[%s%s] %3d%% frame %lld/%lld t=%.2f s, %.0f s left ",
+               std::string(filled, '#').c_str(), std::string(width - filled, ' ').c_str(),
+               static_cast<int>(100 * done / std::max(1LL, total)), done, total, t, eta);
+  std::fflush(stderr);
+}
+
+int Render(const RenderCliOptions& opt) {
+  namespace fs = std::filesystem;
+  mjtether::render::RenderOptions ropt;
+  if (!ParseSize(opt.size, &ropt.width, &ropt.height)) {
+    std::cerr << "mjtether: --size " << opt.size << ": expected WIDTHxHEIGHT, e.g. 1280x720\n";
+    return 2;
+  }
+  if (opt.video.empty() && opt.png_every.empty()) {
+    std::cerr << "mjtether: render: nothing to write; give --video FILE.mp4 and/or --png-every "
+                 "S DIR\n";
+    return 2;
+  }
+  double png_every = 0;
+  std::string png_dir;
+  if (!opt.png_every.empty()) {
+    char* end = nullptr;
+    png_every = std::strtod(opt.png_every[0].c_str(), &end);
+    if (end == opt.png_every[0].c_str() || *end || !(png_every > 0) || png_every > 1e7) {
+      std::cerr << "mjtether: --png-every " << opt.png_every[0]
+                << ": interval must be a number of seconds in (0, 1e7]\n";
+      return 2;
+    }
+    png_dir = opt.png_every[1];
+    std::error_code ec;
+    fs::create_directories(png_dir, ec);
+    if (ec || !fs::is_directory(png_dir)) {
+      std::cerr << "mjtether: --png-every: cannot create directory " << png_dir << "\n";
+      return 2;
+    }
+  }
+  ropt.samples = opt.samples;
+  ropt.camera = opt.camera;
+  ropt.vehicle = opt.vehicle;
+  ropt.hud = !opt.no_hud;
+
+  std::string error;
+  mjModel* m = mjtether::LoadModel(opt.model, &error);
+  if (!m) {
+    std::cerr << "mjtether: " << error << "\n";
+    return 2;
+  }
+  struct Cleanup {
+    mjModel* m;
+    ~Cleanup() {
+      mjtether::Detach(m);
+      mj_deleteModel(m);
+    }
+  } cleanup{m};
+
+  const double h = m->opt.timestep;
+  const double frame_dt = 1.0 / opt.fps;
+  const long long nframes =
+      std::max(1LL, static_cast<long long>(std::floor(opt.duration * opt.fps + 1e-9)));
+
+  // Colour scale: given, or the largest tension of the run rounded up (a pre-pass without
+  // rendering costs a small fraction of the rendering).
+  if (opt.tension_max > 0) {
+    ropt.tension_max = opt.tension_max;
+  } else {
+    std::optional<double> tmax = TensionPrepass(m, nframes, opt.fps);
+    if (!tmax) return 1;
+    ropt.tension_max = mjtether::render::NiceCeil(*tmax);
+  }
+
+  std::unique_ptr<mjtether::render::Renderer> renderer =
+      mjtether::render::Renderer::Create(m, ropt, &error);
+  if (!renderer) {
+    std::cerr << "mjtether: " << opt.model << ": " << error << "\n";
+    return error.rfind("OSMesa", 0) == 0 || error.rfind("MuJoCo", 0) == 0 ? 4 : 2;
+  }
+  const int W = ropt.width, H = ropt.height;
+
+  std::signal(SIGPIPE, SIG_IGN);  // a dead ffmpeg shows up as a failed write, not a signal
+  FfmpegPipe ffmpeg;
+  if (!opt.video.empty() && !ffmpeg.Open(opt.video, W, H, opt.fps, &error)) {
+    std::cerr << "mjtether: cannot start ffmpeg: " << error << "\n";
+    return 4;
+  }
+
+  mjData* d = mj_makeData(m);
+  std::vector<unsigned char> rgb(static_cast<size_t>(3) * W * H);
+  const bool progress = isatty(2);
+  std::vector<double> frame_ms;
+  long long step = 0, next_png = 0, npng = 0;
+  int status = 0;
+  const auto start = std::chrono::steady_clock::now();
+  for (long long k = 0; k < nframes && status == 0; ++k) {
+    // Frame k at step round(k / (fps h)).
+    const long long target = mjtether::render::FrameStep(k, opt.fps, h);
+    for (; step < target; ++step) {
+      mj_step(m, d);
+      if (std::optional<std::string> diverged = mjtether::CheckDivergence(m, d)) {
+        std::cerr << (progress ? "\n" : "") << "mjtether: " << *diverged << "\n";
+        status = 1;
+        break;
+      }
+    }
+    if (status) break;
+    // Still j at frame round(j * png_every * fps).
+    const bool still = png_every > 0 && k == std::llround(next_png * png_every * opt.fps);
+    if (opt.video.empty() && !still) continue;
+
+    mj_forward(m, d);  // the tether at d->time
+    const auto t0 = std::chrono::steady_clock::now();
+    renderer->Render(m, d, rgb.data());
+    frame_ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    if (!opt.video.empty() && !ffmpeg.Write(rgb.data(), rgb.size())) {
+      std::cerr << (progress ? "\n" : "") << "mjtether: ffmpeg stopped reading frames\n";
+      status = 4;
+      break;
+    }
+    if (still) {
+      char name[64];
+      std::snprintf(name, sizeof(name), "t_%09.3f.png", k * frame_dt);
+      if (!mjtether::render::WritePng((fs::path(png_dir) / name).string(), rgb.data(), W, H,
+                                      &error)) {
+        std::cerr << (progress ? "\n" : "") << "mjtether: " << error << "\n";
+        status = 2;
+        break;
+      }
+      ++next_png;
+      ++npng;
+    }
+    if (progress) {
+      Progress(k + 1, nframes, d->time,
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    }
+  }
+  if (progress) std::fprintf(stderr, "\n");
+  mj_deleteData(d);
+
+  if (!opt.video.empty()) {
+    const int rc = ffmpeg.Close();
+    if (rc != 0 && status == 0) {
+      std::cerr << "mjtether: ffmpeg failed (exit status " << rc
+                << (rc == 127 ? ": ffmpeg not found on PATH" : "") << ") writing " << opt.video
+                << "\n";
+      status = 4;
+    }
+  }
+  if (status == 0) {
+    const double wall =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::vector<double> sorted = frame_ms;
+    std::sort(sorted.begin(), sorted.end());
+    const double median = sorted.empty() ? 0 : sorted[sorted.size() / 2];
+    std::cerr << "mjtether: rendered " << frame_ms.size() << " frame(s) " << W << "x" << H << ", "
+              << renderer->samples() << " MSAA samples, tension scale 0-" << ropt.tension_max
+              << " N, in " << wall << " s (median " << median << " ms/frame)";
+    if (!opt.video.empty()) std::cerr << "; video: " << opt.video;
+    if (npng > 0) std::cerr << "; " << npng << " still(s) in " << png_dir;
+    std::cerr << "\n";
+  }
+  return status;
+}
+
+std::function<int()> SetupRender(CLI::App* sub) {
+  auto opt = std::make_shared<RenderCliOptions>();
+  sub->add_option("model", opt->model, "MJCF file declaring the tethers")
+      ->required()
+      ->check(CLI::ExistingFile);
+  sub->add_option("--duration", opt->duration, "simulated time [s]")
+      ->required()
+      ->check(CLI::Range(0.0, 1e5));
+  sub->add_option("--video", opt->video, "MP4 file (H.264, yuv420p) written by ffmpeg");
+  sub->add_option("--fps", opt->fps, "frames per second of simulated time (default 30)")
+      ->check(CLI::Range(0.01, 1000.0));
+  sub->add_option("--size", opt->size, "WIDTHxHEIGHT in pixels, even numbers (default 1280x720)");
+  sub->add_option("--camera", opt->camera,
+                  "follow (default), track:BODY, or the name of a <camera> in the model");
+  sub->add_option("--png-every", opt->png_every, "S DIR: a PNG still every S seconds into DIR")
+      ->expected(2);
+  sub->add_option("--samples", opt->samples,
+                  "multisampling samples, 0 to 16 (default 4; 0 is about twice as fast)")
+      ->check(CLI::Range(0, 16));
+  sub->add_option("--tension-max", opt->tension_max,
+                  "top of the tension colour scale [N]; default: the run's largest tension "
+                  "rounded up to 1, 2 or 5 x 10^k")
+      ->check(CLI::Range(0.0, 1e12));
+  sub->add_option("--vehicle", opt->vehicle, "body whose depth the HUD shows");
+  sub->add_flag("--no-hud", opt->no_hud, "no text overlay or colour scale");
+  return [opt]() { return Render(*opt); };
+}
+
+const bool registered =
+    mjtether::cli::Register({"render", "render a video and/or PNG stills off-screen", SetupRender});
+
+}  // namespace

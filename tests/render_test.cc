@@ -1,0 +1,368 @@
+// Off-screen rendering: tether pixels where the nodes project, colours on the tension scale,
+// the CLI's video (frame count and size through ffprobe), stills and plot.
+#include "render.h"
+
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mjtether.h"
+
+namespace mjtether::render {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Two straight tethers between world sites, no gravity, dry: each carries the uniform tension
+// EA * (span / length - 1) (no other force acts). "hot": 10 m span, 9.5 m long, EA 1.9e4 N:
+// T = 1000 N; "mid": same span, EA 0.95e4 N: T = 500 N. On a 0-1000 N scale they are red and
+// green. A fixed camera 15 m in front looks along +y.
+constexpr char kTwoTethers[] = R"(
+<mujoco>
+  <option gravity="0 0 0"/>
+  <custom>
+    <text name="tether:hot" data="ends=h0,h1 length=9.5 segments=10 diameter=0.02
+          mass_per_length=0.3 EA=1.9e4"/>
+    <text name="tether:mid" data="ends=m0,m1 length=9.5 segments=10 diameter=0.02
+          mass_per_length=0.3 EA=0.95e4"/>
+  </custom>
+  <worldbody>
+    <site name="h0" pos="0 0 1"/>  <site name="h1" pos="10 0 1"/>
+    <site name="m0" pos="0 0 -1"/> <site name="m1" pos="10 0 -1"/>
+    <camera name="side" pos="5 -15 0" xyaxes="1 0 0 0 0 1"/>
+  </worldbody>
+</mujoco>)";
+
+constexpr double kTensionHot = 1000;  // [N] EA * (10/9.5 - 1)
+constexpr double kTensionMid = 500;   // [N]
+
+class RenderTest : public ::testing::Test {
+ protected:
+  void TearDown() override {
+    if (d_) mj_deleteData(d_);
+    if (m_) {
+      Detach(m_);
+      mj_deleteModel(m_);
+    }
+  }
+  void Load(const char* xml) {
+    std::string error;
+    m_ = LoadModelFromString(xml, "render_test.xml", &error);
+    ASSERT_NE(m_, nullptr) << error;
+    d_ = mj_makeData(m_);
+    mj_forward(m_, d_);  // sets the initial shape: straight, stretched
+  }
+  mjModel* m_ = nullptr;
+  mjData* d_ = nullptr;
+};
+
+// Pixel (column, row from the bottom) where world point p projects through the scene's camera,
+// as mjr_render sets up OpenGL: a look-at view from pos along forward with up, and a frustum
+// [center -/+ half width] x [bottom, top] at the near plane, its width from the aspect ratio.
+std::array<double, 2> Project(const mjvScene& scn, int W, int H, const double* p) {
+  const mjvGLCamera& c = scn.camera[0];
+  double v[3], right[3];
+  for (int i = 0; i < 3; ++i) v[i] = p[i] - c.pos[i];
+  const double f[3] = {c.forward[0], c.forward[1], c.forward[2]};
+  const double u[3] = {c.up[0], c.up[1], c.up[2]};
+  mju_cross(right, f, u);
+  const double z = mju_dot3(v, f);
+  const double xn = c.frustum_near * mju_dot3(v, right) / z;
+  const double yn = c.frustum_near * mju_dot3(v, u) / z;
+  const double half_w = 0.5 * W / H * (c.frustum_top - c.frustum_bottom);
+  const double left = c.frustum_center - half_w;
+  return {W * (xn - left) / (2 * half_w),
+          H * (yn - c.frustum_bottom) / (c.frustum_top - c.frustum_bottom)};
+}
+
+TEST_F(RenderTest, TetherPixelsAppearWhereTheNodesProjectInTheirTensionColour) {
+  Load(kTwoTethers);
+  const int W = 640, H = 480;
+  RenderOptions opt;
+  opt.width = W;
+  opt.height = H;
+  opt.samples = 0;  // crisp edges: a pixel is the tether's or not
+  opt.camera = "side";
+  opt.tension_max = kTensionHot;
+  opt.hud = false;
+  std::string error;
+  std::unique_ptr<Renderer> r = Renderer::Create(m_, opt, &error);
+  ASSERT_NE(r, nullptr) << error;
+  // The off-screen buffer is the requested size (a larger viewport would be cropped).
+  EXPECT_EQ(m_->vis.global.offwidth, W);
+  EXPECT_EQ(m_->vis.global.offheight, H);
+
+  // The tensions are the ones the colours are chosen for (straight, uniform).
+  for (int k = 0; k < 2; ++k) {
+    std::vector<double> T(10);
+    GetTensions(m_, d_, k, T.data());
+    const double expected = TetherName(m_, k) == "hot" ? kTensionHot : kTensionMid;
+    for (double t : T) EXPECT_NEAR(t, expected, 1e-6 * expected);
+  }
+
+  std::vector<unsigned char> with(3 * W * H), without(3 * W * H);
+  r->Render(m_, d_, with.data());
+  const mjvScene scn = r->scene();  // camera of the frame with tethers
+  RenderOptions bare = opt;
+  bare.draw_tethers = false;
+  std::unique_ptr<Renderer> r0 = Renderer::Create(m_, bare, &error);
+  ASSERT_NE(r0, nullptr) << error;
+  r0->Render(m_, d_, without.data());
+
+  // Not blank: the background alone has a vertical gradient (distinct rows), and the tethers
+  // change pixels.
+  int changed = 0;
+  for (int i = 0; i < W * H; ++i) {
+    changed += std::abs(with[3 * i] - without[3 * i]) +
+                   std::abs(with[3 * i + 1] - without[3 * i + 1]) +
+                   std::abs(with[3 * i + 2] - without[3 * i + 2]) >
+               30;
+  }
+  EXPECT_NE(without[3 * (W / 2)], without[3 * ((H - 1) * W + W / 2) + 2]);
+  EXPECT_GT(changed, 500);
+
+  // At every interior node, a pixel within 1 px of the projection has the tether's colour:
+  // red (R > 2G, R > 2B) for "hot", green (G > 2R, G > 2B) for "mid". Shading scales the
+  // channels together, so ratios of 2 leave margin (the ramp's red is 0.95/0.10/0.05, its green
+  // 0.15/0.85/0.15) while excluding the water (blue) and the other tether.
+  int checked = 0;
+  for (int k = 0; k < 2; ++k) {
+    const bool hot = TetherName(m_, k) == "hot";
+    const double* x = NodePositions(m_, d_, k);
+    for (int i = 1; i < 10; ++i) {
+      const std::array<double, 2> px = Project(scn, W, H, x + 3 * i);
+      const int cx = static_cast<int>(std::lround(px[0])), cy = static_cast<int>(px[1]);
+      ASSERT_TRUE(cx > 1 && cx < W - 2 && cy > 1 && cy < H - 2) << "node off screen";
+      bool found = false;
+      for (int dy = -1; dy <= 1 && !found; ++dy) {
+        for (int dx = -1; dx <= 1 && !found; ++dx) {
+          const unsigned char* p = with.data() + 3 * ((cy + dy) * W + cx + dx);
+          const int R = p[0], G = p[1], B = p[2];
+          found = hot ? (R > 2 * G && R > 2 * B) : (G > 2 * R && G > 2 * B);
+        }
+      }
+      EXPECT_TRUE(found) << TetherName(m_, k) << " node " << i << " at pixel (" << cx << ", " << cy
+                         << ")";
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 18);
+
+  // Nothing changes away from the tethers: pixels farther than 6 px from both projected lines
+  // (the capsules are about 4 px thick here) are identical with and without them.
+  const double* a = NodePositions(m_, d_, 0);
+  const double* b = NodePositions(m_, d_, 1);
+  const std::array<double, 2> lines[2][2] = {{Project(scn, W, H, a), Project(scn, W, H, a + 30)},
+                                             {Project(scn, W, H, b), Project(scn, W, H, b + 30)}};
+  int far_changed = 0;
+  for (int row = 0; row < H; ++row) {
+    for (int col = 0; col < W; ++col) {
+      bool near = false;
+      for (const auto& l : lines) {
+        const double x0 = l[0][0], y0 = l[0][1], x1 = l[1][0], y1 = l[1][1];
+        const double t = std::clamp(((col - x0) * (x1 - x0) + (row - y0) * (y1 - y0)) /
+                                        ((x1 - x0) * (x1 - x0) + (y1 - y0) * (y1 - y0)),
+                                    0.0, 1.0);
+        near |= std::hypot(col - (x0 + t * (x1 - x0)), row - (y0 + t * (y1 - y0))) < 6;
+      }
+      const int i = row * W + col;
+      if (!near && (with[3 * i] != without[3 * i] || with[3 * i + 1] != without[3 * i + 1] ||
+                    with[3 * i + 2] != without[3 * i + 2])) {
+        ++far_changed;
+      }
+    }
+  }
+  EXPECT_EQ(far_changed, 0);
+}
+
+TEST_F(RenderTest, HudDrawsTextInTheTopLeftCorner) {
+  Load(kTwoTethers);
+  RenderOptions opt;
+  opt.width = 320;
+  opt.height = 240;
+  opt.samples = 0;
+  opt.camera = "side";
+  opt.tension_max = kTensionHot;
+  std::string error;
+  std::unique_ptr<Renderer> r = Renderer::Create(m_, opt, &error);
+  ASSERT_NE(r, nullptr) << error;
+  opt.hud = false;
+  std::unique_ptr<Renderer> r0 = Renderer::Create(m_, opt, &error);
+  ASSERT_NE(r0, nullptr) << error;
+  std::vector<unsigned char> with(3 * 320 * 240), without(3 * 320 * 240);
+  r->Render(m_, d_, with.data());
+  r0->Render(m_, d_, without.data());
+  // The top-left 80x40 pixels (rows from the bottom: 200-239) hold the HUD's first lines.
+  int changed = 0;
+  for (int row = 200; row < 240; ++row) {
+    for (int col = 0; col < 80; ++col) {
+      const int i = 3 * (row * 320 + col);
+      changed += with[i] != without[i] || with[i + 1] != without[i + 1];
+    }
+  }
+  EXPECT_GT(changed, 200);
+}
+
+TEST_F(RenderTest, CreateRejectsBadOptionsWithAMessage) {
+  Load(kTwoTethers);
+  std::string error;
+  RenderOptions opt;
+  opt.width = 641;
+  EXPECT_EQ(Renderer::Create(m_, opt, &error), nullptr);
+  EXPECT_NE(error.find("even"), std::string::npos) << error;
+  opt = RenderOptions();
+  opt.camera = "nosuch";
+  EXPECT_EQ(Renderer::Create(m_, opt, &error), nullptr);
+  EXPECT_NE(error.find("nosuch"), std::string::npos) << error;
+  opt = RenderOptions();
+  opt.camera = "track:nobody";
+  EXPECT_EQ(Renderer::Create(m_, opt, &error), nullptr);
+  EXPECT_NE(error.find("nobody"), std::string::npos) << error;
+  opt = RenderOptions();
+  opt.samples = 17;
+  EXPECT_EQ(Renderer::Create(m_, opt, &error), nullptr);
+  EXPECT_NE(error.find("[0, 16]"), std::string::npos) << error;
+}
+
+TEST(TensionColor, SlackIsGreyAndTheRampRunsBlueToRed) {
+  float c[4];
+  for (double T : {0.0, -5.0}) {
+    TensionColor(T, 100, c);
+    EXPECT_EQ(c[0], c[1]);
+    EXPECT_EQ(c[1], c[2]);
+  }
+  TensionColor(1e-9, 100, c);  // the smallest tension is blue, not grey
+  EXPECT_GT(c[2], 2 * c[0]);
+  TensionColor(50, 100, c);  // middle: green
+  EXPECT_GT(c[1], 2 * c[0]);
+  EXPECT_GT(c[1], 2 * c[2]);
+  float top[4], above[4];
+  TensionColor(100, 100, top);  // top and above the scale: red
+  TensionColor(1e6, 100, above);
+  EXPECT_GT(top[0], 5 * top[1]);
+  for (int i = 0; i < 4; ++i) EXPECT_EQ(top[i], above[i]);
+}
+
+TEST(NiceCeil, RoundsUpToOneTwoOrFiveTimesAPowerOfTen) {
+  EXPECT_DOUBLE_EQ(NiceCeil(0.3), 0.5);
+  EXPECT_DOUBLE_EQ(NiceCeil(200), 200);
+  EXPECT_DOUBLE_EQ(NiceCeil(201), 500);
+  EXPECT_DOUBLE_EQ(NiceCeil(501), 1000);
+  EXPECT_DOUBLE_EQ(NiceCeil(0), 1);
+}
+
+// Frames scheduled by index never drift: over an hour at 30 fps with a 2 ms step (1/30 s is
+// not a whole number of steps), frame k is within half a step of k/30.
+TEST(FrameStep, FrameTimesStayWithinHalfAStepOfKOverFps) {
+  const double h = 0.002, fps = 30;
+  double worst = 0;
+  for (long long k = 0; k < 3600 * 30; ++k) {
+    worst = std::max(worst, std::abs(FrameStep(k, fps, h) * h - k / fps));
+  }
+  EXPECT_LE(worst, 0.5 * h * (1 + 1e-9));
+}
+
+// ---- the command line ----
+
+std::string Shell(const std::string& command, int* status) {
+  std::string out;
+  FILE* p = popen(command.c_str(), "r");
+  if (!p) {
+    *status = -1;
+    return out;
+  }
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof(buf), p)) > 0) out.append(buf, n);
+  const int s = pclose(p);
+  *status = WIFEXITED(s) ? WEXITSTATUS(s) : -1;
+  return out;
+}
+
+bool Have(const std::string& tool) {
+  int status = 0;
+  Shell("command -v " + tool + " >/dev/null 2>&1", &status);
+  return status == 0;
+}
+
+// Width and height from a PNG's IHDR chunk (bytes 16-23, big-endian).
+std::array<int, 2> PngSize(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  unsigned char h[24] = {};
+  f.read(reinterpret_cast<char*>(h), 24);
+  if (!f || h[1] != 'P' || h[2] != 'N' || h[3] != 'G') return {0, 0};
+  auto be = [&](int o) { return (h[o] << 24) | (h[o + 1] << 16) | (h[o + 2] << 8) | h[o + 3]; };
+  return {be(16), be(20)};
+}
+
+class RenderCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("mjtether_render_test_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+  const std::string cli_ = MJTETHER_CLI;
+  const std::string model_ = std::string(MJTETHER_MODELS_DIR) + "/rov_tether.xml";
+};
+
+TEST_F(RenderCli, VideoHasTheFrameCountAndSizeAsked) {
+  if (!Have("ffmpeg") || !Have("ffprobe")) {
+    GTEST_SKIP() << "ffmpeg or ffprobe is not installed: cannot write or inspect the video";
+  }
+  const std::string video = (dir_ / "out.mp4").string();
+  int status = 0;
+  Shell(cli_ + " render " + model_ + " --duration 1 --fps 10 --size 160x120 --samples 0" +
+            " --video " + video + " --png-every 0.5 " + (dir_ / "stills").string() + " 2>&1",
+        &status);
+  ASSERT_EQ(status, 0);
+  // 1 s at 10 fps: frames at t = 0, 0.1, ..., 0.9.
+  const std::string probe = Shell(
+      "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+      "stream=width,height,nb_read_frames,codec_name,pix_fmt -of csv=p=0 " +
+          video,
+      &status);
+  ASSERT_EQ(status, 0);
+  EXPECT_EQ(probe, "h264,160,120,yuv420p,10\n");
+  // Stills at t = 0 and 0.5 s, the video's size.
+  for (const char* name : {"t_00000.000.png", "t_00000.500.png"}) {
+    const std::array<int, 2> size = PngSize((dir_ / "stills" / name).string());
+    EXPECT_EQ(size[0], 160) << name;
+    EXPECT_EQ(size[1], 120) << name;
+  }
+  int stills = 0;
+  for (const auto& e : fs::directory_iterator(dir_ / "stills")) stills += e.is_regular_file();
+  EXPECT_EQ(stills, 2);
+}
+
+TEST_F(RenderCli, FfmpegFailureIsExitCode4AndBadSizeIs2) {
+  int status = 0;
+  const std::string out = Shell(cli_ + " render " + model_ +
+                                    " --duration 0.1 --fps 10 --size 64x48 --samples 0 --video " +
+                                    (dir_ / "no" / "such" / "dir" / "out.mp4").string() + " 2>&1",
+                                &status);
+  if (Have("ffmpeg")) {
+    EXPECT_EQ(status, 4) << out;
+    EXPECT_NE(out.find("ffmpeg"), std::string::npos) << out;
+  }
+  const std::string bad = Shell(
+      cli_ + " render " + model_ + " --duration 0.1 --size 641x480 --video x.mp4 2>&1", &status);
+  EXPECT_EQ(status, 2) << bad;
+  EXPECT_NE(bad.find("even"), std::string::npos) << bad;
+}
+
+}  // namespace
+}  // namespace mjtether::render
