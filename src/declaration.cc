@@ -115,7 +115,9 @@ std::optional<KeyValues> SplitKeyValues(const std::string& text, DeclarationErro
     }
     std::string key = token.substr(0, eq), value = token.substr(eq + 1);
     if (key.empty() || value.empty()) {
-      Fail(error, key, "'" + token + "' needs both a key and a value (key=value, no spaces)");
+      Fail(error, key,
+           (key.empty() ? "" : "key '" + key + "': ") + "'" + token +
+               "' needs both a key and a value (key=value, no spaces)");
       return std::nullopt;
     }
     for (const auto& kv : pairs) {

@@ -15,6 +15,10 @@ constexpr double kMinLengthRatio = 1e-9;
 // Fraction of the explicit stability limit actually used (the estimate ignores drag and the
 // geometric stiffness T/l, both small against EA/L0 in practice).
 constexpr double kExplicitSafety = 0.8;
+// Kinetic energy above this multiple of EnergyBound() is a blow-up (the bound is already
+// generous; the factor keeps a violent but physical transient, e.g. a whipping free end,
+// clear of it).
+constexpr double kEnergyBlowUp = 10;
 
 // Scratch memory of one evaluation, carved from the caller's workspace.
 struct Work {
@@ -701,7 +705,41 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
       return status;
     }
   }
+  // Energy blow-up: more kinetic energy than the tether could hold physically (an unstable
+  // mode grows geometrically and crosses this long before it overflows to NaN).
+  double kinetic = 0, node_max = -1;
+  int fastest = -1;
+  for (int i = 0; i < n; ++i) {
+    if (!Dynamic(i)) continue;
+    const double e = 0.5 * (mass_(i) + added_(i)) * v.col(i).squaredNorm();
+    kinetic += e;
+    if (e > node_max) node_max = e, fastest = i;
+  }
+  const double bound = kEnergyBlowUp * EnergyBound(from, to);
+  if (kinetic > bound) {
+    status = {false, fastest,
+              "kinetic energy " + std::to_string(kinetic) + " J exceeds " +
+                  std::to_string(bound) + " J, " + std::to_string(kEnergyBlowUp) +
+                  " times the most the tether can physically hold"};
+  }
   return status;
+}
+
+// The most energy the tether can hold without diverging [J]: elastic energy at max_strain
+// along its whole length, ½ EA max_strain² L; bending energy of a fold at every node,
+// ½ EI (2/L0)² L; the kinetic energy of the whole tether (with added mass) moving with its
+// fastest end plus the current; and the work of its net weight falling its own length.
+double Tether::EnergyBound(const Ends& from, const Ends& to) const {
+  const double L = p_.length;
+  double v = std::max(from.a.vel.norm(), to.a.vel.norm());
+  if (!p_.free_end) v = std::max({v, from.b.vel.norm(), to.b.vel.norm()});
+  if (Has(kCurrent)) v += env_.water.current.norm();
+  const double M = mass_.sum() + added_.sum();
+  double E = 0.5 * p_.EA * p_.max_strain * p_.max_strain * L + 0.5 * M * v * v;
+  if (Has(kBending)) E += 0.5 * p_.EI * (4 / (L0_ * L0_)) * L;
+  double W = 0;  // [N] net weight, without sign
+  for (int i = 0; i <= N_; ++i) W += weight_.col(i).norm();
+  return E + W * L;
 }
 
 }  // namespace mjtether

@@ -111,6 +111,9 @@ class Tether {
   // bending) and gravitational (weight minus buoyancy, relative to z = 0).
   double KineticEnergy(const double* x, const double* v) const;
   double PotentialEnergy(const double* x, const Ends& ends) const;
+  // The most energy the tether can hold physically while its ends move from `from` to `to`
+  // [J] (see tether.cc); Advance reports a kinetic energy above 10 times this as divergence.
+  double EnergyBound(const Ends& from, const Ends& to) const;
 
   // Node masses [kg] (dry, lumped) and net weight force [N] per node.
   double node_mass(int i) const { return mass_[i]; }

@@ -1,0 +1,518 @@
+// Robustness: the time-step advisor, divergence reports, bad input through the command line,
+// concurrency, and a long run of the default scene with flat memory.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
+
+#include "mjtether.h"
+
+namespace mjtether {
+namespace {
+
+void FailOnWarning(const char* message) { ADD_FAILURE() << "MuJoCo warning: " << message; }
+void AbortOnError(const char* message) {
+  std::fprintf(stderr, "MuJoCo error: %s\n", message);
+  std::abort();
+}
+
+// Loads models from strings, deletes them and their data at the end of the test.
+class Scene : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    mju_user_warning = FailOnWarning;
+    mju_user_error = AbortOnError;
+  }
+  void TearDown() override {
+    for (mjData* d : datas_) mj_deleteData(d);
+    for (mjModel* m : models_) {
+      Detach(m);
+      mj_deleteModel(m);
+    }
+  }
+  mjModel* Load(const std::string& xml, const std::string& name = "scene.xml") {
+    std::string error;
+    mjModel* m = LoadModelFromString(xml, name, &error);
+    EXPECT_NE(m, nullptr) << error;
+    if (m) models_.push_back(m);
+    return m;
+  }
+  mjData* Make(mjModel* m) {
+    mjData* d = mj_makeData(m);
+    datas_.push_back(d);
+    return d;
+  }
+  std::vector<mjModel*> models_;
+  std::vector<mjData*> datas_;
+};
+
+bool Contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+std::string Fmt(double x) {
+  std::ostringstream s;
+  s << x;
+  return s.str();
+}
+
+// A 20 m line of 40 segments between two world sites in air, sagging; `extra` is appended to
+// the declaration.
+std::string LineXml(const std::string& extra, double timestep = 0.002,
+                    const std::string& stiffness = "EA=1e6 segments=40") {
+  std::ostringstream s;
+  s << R"(<mujoco><option timestep=")" << timestep << R"("/><custom>
+      <text name="tether:line" data="ends=a,b length=20 diameter=0.02
+            mass_per_length=0.5 damping=10 )"
+    << stiffness << " " << extra << R"("/></custom>
+    <worldbody><site name="a" pos="0 0 0"/><site name="b" pos="15 0 0"/></worldbody>
+    </mujoco>)";
+  return s.str();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Time-step advisor
+
+// An explicit tether whose fixed `substeps` make its step longer than the stability limit gets
+// one warning naming the file, the tether, the limit and the setting to change; the advice is
+// right: with the substeps it recommends the run stays finite, with the declared ones it
+// diverges.
+TEST_F(Scene, AdvisorWarnsWhenFixedSubstepsExceedTheLimit) {
+  mjModel* m = Load(LineXml("integrator=explicit substeps=2"), "coarse.xml");
+  ASSERT_NE(m, nullptr);
+  const double limit = GetTether(m, 0)->ExplicitStableStep();
+  ASSERT_GT(0.001, limit);  // 2 substeps of 1 ms are too long: the case is real
+  const std::vector<std::string> warnings = Warnings(m);
+  ASSERT_EQ(warnings.size(), 1u);
+  const std::string& w = warnings[0];
+  EXPECT_TRUE(Contains(w, "coarse.xml: <text name=\"tether:line\">")) << w;
+  EXPECT_TRUE(Contains(w, "stability limit " + Fmt(limit) + " s")) << w;
+  const int advised = static_cast<int>(std::ceil(0.002 / limit));
+  EXPECT_TRUE(Contains(w, "substeps >= " + std::to_string(advised))) << w;
+  EXPECT_TRUE(Contains(w, "integrator=implicit")) << w;
+
+  // The declared setting diverges within 0.2 s; the advised one is stable for 1 s.
+  mjData* d = Make(m);
+  while (d->time < 0.2 && !CheckDivergence(m, d)) mj_step(m, d);
+  EXPECT_TRUE(CheckDivergence(m, d));
+  mjModel* fixed =
+      Load(LineXml("integrator=explicit substeps=" + std::to_string(advised)), "fixed.xml");
+  EXPECT_TRUE(Warnings(fixed).empty());
+  mjData* e = Make(fixed);
+  while (e->time < 1) mj_step(fixed, e);
+  EXPECT_FALSE(CheckDivergence(fixed, e));
+}
+
+// The same for max_step; no warning for automatic substeps or for the implicit integrator,
+// whatever the step.
+TEST_F(Scene, AdvisorCoversMaxStepAndIsSilentOtherwise) {
+  mjModel* m = Load(LineXml("integrator=explicit max_step=0.001"));
+  ASSERT_EQ(Warnings(m).size(), 1u);
+  EXPECT_TRUE(Contains(Warnings(m)[0], "max_step <= ")) << Warnings(m)[0];
+  mjModel* automatic = Load(LineXml("integrator=explicit"));
+  EXPECT_TRUE(Warnings(automatic).empty());
+  const Tether* t = GetTether(automatic, 0);
+  // Automatic substeps: the smallest count whose step is within the limit.
+  const int n = t->SubstepsFor(0.002);
+  EXPECT_LE(0.002 / n, t->ExplicitStableStep());
+  EXPECT_GT(0.002 / (n - 1), t->ExplicitStableStep());
+  mjModel* implicit = Load(LineXml("integrator=implicit substeps=1"));
+  EXPECT_TRUE(Warnings(implicit).empty());
+}
+
+// An explicit tether that would need more than 1e5 substeps per MuJoCo step is refused at
+// load time with the count and what to change (it would otherwise run for hours).
+TEST_F(Scene, AbsurdAutomaticSubstepsAreRefused) {
+  std::string error;
+  mjModel* m = LoadModelFromString(
+      LineXml("integrator=explicit", 0.002, "EA=1e13 segments=1000"), "stiff.xml", &error);
+  ASSERT_EQ(m, nullptr);
+  EXPECT_TRUE(Contains(error, "stiff.xml: <text name=\"tether:line\">")) << error;
+  EXPECT_TRUE(Contains(error, "more than 100000")) << error;
+  EXPECT_TRUE(Contains(error, "integrator=implicit")) << error;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Divergence at run time
+
+// A run that diverges stops with a message naming the file, the tether, the time, the node and
+// what to change; the tether then applies no force.
+TEST_F(Scene, DivergenceMessageNamesTetherTimeNodeAndRemedy) {
+  mjModel* m = Load(LineXml("integrator=explicit substeps=1"), "unstable.xml");
+  mjData* d = Make(m);
+  std::optional<std::string> message;
+  while (d->time < 1 && !(message = CheckDivergence(m, d))) mj_step(m, d);
+  ASSERT_TRUE(message);
+  EXPECT_TRUE(Contains(*message, "unstable.xml: tether 'line' diverged at t = ")) << *message;
+  EXPECT_TRUE(Contains(*message, " at node ")) << *message;
+  EXPECT_TRUE(Contains(*message, "of 41")) << *message;
+  EXPECT_TRUE(Contains(*message, "stable step")) << *message;
+  EXPECT_TRUE(Contains(*message, "integrator=implicit")) << *message;
+}
+
+// Energy blow-up: a node given more kinetic energy than the tether can hold is reported as
+// such, naming that node (a state an unstable scheme reaches before any NaN). The time step is
+// 0.1 us so that the node moves 9 mm in it: no strain check can see it first.
+TEST_F(Scene, KineticEnergyBlowUpIsReported) {
+  mjModel* m = Load(LineXml("integrator=implicit", 1e-7), "blowup.xml");
+  mjData* d = Make(m);
+  for (int k = 0; k < 10; ++k) mj_step(m, d);
+  ASSERT_FALSE(CheckDivergence(m, d));
+  const Tether* t = GetTether(m, 0);
+  // EnergyBound for fixed ends: elastic at max_strain, gravity over the length.
+  Ends ends;
+  const double bound = t->EnergyBound(ends, ends);
+  // Node 17 moving sideways with 100 times the bound (9e4 m/s).
+  double* v = const_cast<double*>(NodeVelocities(m, d, 0));
+  v[3 * 17 + 1] = std::sqrt(2 * 100 * bound / t->node_mass(17));
+  mj_step(m, d);
+  std::optional<std::string> message = CheckDivergence(m, d);
+  ASSERT_TRUE(message);
+  EXPECT_TRUE(Contains(*message, "at node 17 of 41 (kinetic energy blow-up)")) << *message;
+  EXPECT_TRUE(Contains(*message, "Reduce <option timestep>")) << *message;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bad input through the command line: exit code 2 and a message naming the file, the element,
+// the key and the allowed range. One case per class of error, for tethers and for the water.
+
+int RunCli(const std::string& args, std::string* output) {
+  const std::string out = ::testing::TempDir() + "/robust_cli_" + std::to_string(getpid());
+  const int status = std::system((std::string(MJTETHER_CLI) + " " + args + " > " + out +
+                                  " 2>&1 < /dev/null")
+                                     .c_str());
+  std::ifstream f(out);
+  std::stringstream s;
+  s << f.rdbuf();
+  *output = s.str();
+  std::remove(out.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+const char* kGoodTether =
+    "ends=a,b length=10 segments=10 diameter=0.02 mass_per_length=0.5 EA=1e5 EI=0.1 "
+    "damping=5 Cdn=1.2 Cdt=0.01 Can=1";
+const char* kGoodWater = "density=1025 current=0.3,0,0 seabed=-20";
+
+struct BadInput {
+  const char* name;     // test name
+  std::string water;    // text of <text name="water">; empty: none
+  std::string tether;   // text of <text name="tether:u">
+  const char* element;  // the element the message must name
+  const char* key;      // the key it must name ('' quoted), or empty
+  const char* allowed;  // the allowed range or values it must give
+  std::string sites = R"(<site name="a"/><site name="b" pos="8 0 0"/>)";
+};
+
+std::string Replace(std::string text, const std::string& what, const std::string& by) {
+  const size_t at = text.find(what);
+  EXPECT_NE(at, std::string::npos) << what;
+  if (at != std::string::npos) text.replace(at, what.size(), by);
+  return text;
+}
+std::string BadTether(const std::string& what, const std::string& by) {
+  return Replace(kGoodTether, what, by);
+}
+std::string BadWater(const std::string& what, const std::string& by) {
+  return Replace(kGoodWater, what, by);
+}
+
+class CliBadInput : public ::testing::TestWithParam<BadInput> {};
+
+TEST_P(CliBadInput, ExitsWith2NamingFileElementKeyAndRange) {
+  const BadInput& c = GetParam();
+  const std::string path = ::testing::TempDir() + "/bad_" + c.name + ".xml";
+  {
+    std::ofstream f(path);
+    f << "<mujoco><custom>";
+    if (!c.water.empty()) f << "<text name=\"water\" data=\"" << c.water << "\"/>";
+    f << "<text name=\"tether:u\" data=\"" << c.tether << "\"/></custom><worldbody>" << c.sites
+      << "</worldbody></mujoco>";
+  }
+  for (const char* command : {"info ", "run "}) {
+    std::string output;
+    const std::string args = command + path + (command[0] == 'r' ? " --duration 0.01" : "");
+    EXPECT_EQ(RunCli(args, &output), 2) << output;
+    EXPECT_TRUE(Contains(output, path + ": <text name=\"" + c.element + "\">")) << output;
+    if (*c.key) {
+      EXPECT_TRUE(Contains(output, std::string("'") + c.key + "'")) << output;
+    }
+    EXPECT_TRUE(Contains(output, c.allowed)) << output;
+    EXPECT_EQ(std::count(output.begin(), output.end(), '\n'), 1) << "one line: " << output;
+  }
+}
+
+std::string BadName(const ::testing::TestParamInfo<BadInput>& info) { return info.param.name; }
+
+INSTANTIATE_TEST_SUITE_P(
+    Tether, CliBadInput,
+    ::testing::Values(
+        BadInput{"missing_key", kGoodWater, BadTether("EA=1e5 ", ""), "tether:u", "EA",
+                 "missing required key"},
+        BadInput{"unknown_key", kGoodWater, std::string(kGoodTether) + " colour=red",
+                 "tether:u", "colour", "allowed keys: ends, length"},
+        BadInput{"not_a_number", kGoodWater, BadTether("length=10", "length=ten"), "tether:u",
+                 "length", "not a number"},
+        BadInput{"nan", kGoodWater, BadTether("diameter=0.02", "diameter=nan"), "tether:u",
+                 "diameter", "not a finite number"},
+        BadInput{"infinity", kGoodWater, BadTether("mass_per_length=0.5", "mass_per_length=inf"),
+                 "tether:u", "mass_per_length", "not a finite number"},
+        BadInput{"negative", kGoodWater, BadTether("damping=5", "damping=-5"), "tether:u",
+                 "damping", "[0, 1e+12]"},
+        BadInput{"zero", kGoodWater, BadTether("EA=1e5", "EA=0"), "tether:u", "EA",
+                 "(0, 1e+13]"},
+        BadInput{"huge_segments", kGoodWater, BadTether("segments=10", "segments=1e9"),
+                 "tether:u", "segments", "[1, 100000]"},
+        BadInput{"fractional_segments", kGoodWater, BadTether("segments=10", "segments=10.5"),
+                 "tether:u", "segments", "whole number"},
+        BadInput{"huge_coefficient", kGoodWater, BadTether("Cdn=1.2", "Cdn=1e9"), "tether:u",
+                 "Cdn", "[0, 100]"},
+        BadInput{"bad_word", kGoodWater, std::string(kGoodTether) + " integrator=rk4",
+                 "tether:u", "integrator", "explicit, implicit"},
+        BadInput{"missing_site", kGoodWater, BadTether("ends=a,b", "ends=a,c"), "tether:u",
+                 "ends", "no site named 'c'"},
+        BadInput{"same_site_twice", kGoodWater, BadTether("ends=a,b", "ends=b,b"), "tether:u",
+                 "ends", "both ends are on site 'b'"},
+        BadInput{"one_site", kGoodWater, BadTether("ends=a,b", "ends=a"), "tether:u", "ends",
+                 "two site names A,B"},
+        BadInput{"malformed_pair", kGoodWater, BadTether("EI=0.1", "EI 0.1"), "tether:u", "",
+                 "'EI' is not of the form key=value"},
+        BadInput{"empty_value", kGoodWater, BadTether("EI=0.1", "EI="), "tether:u", "EI",
+                 "needs both a key and a value"},
+        BadInput{"duplicate_key", kGoodWater, std::string(kGoodTether) + " EA=2e5",
+                 "tether:u", "EA", "given twice"},
+        BadInput{"exclusive_keys", kGoodWater,
+                 std::string(kGoodTether) + " substeps=2 max_step=0.001", "tether:u",
+                 "substeps", "exclude each other"},
+        BadInput{"effect_not_available", "", std::string(kGoodTether) + " effects=axial,drag",
+                 "tether:u", "effects", "needs a water declaration"},
+        BadInput{"absurd_explicit_substeps", kGoodWater,
+                 Replace(BadTether("segments=10", "segments=1000"), "EA=1e5", "EA=1e13") +
+                     " integrator=explicit",
+                 "tether:u", "",
+                 "more than 100000"}),
+    BadName);
+
+INSTANTIATE_TEST_SUITE_P(
+    Water, CliBadInput,
+    ::testing::Values(
+        BadInput{"water_unknown_key", std::string(kGoodWater) + " salinity=35", kGoodTether,
+                 "water", "salinity", "allowed keys: density"},
+        BadInput{"water_not_a_number", BadWater("density=1025", "density=x"), kGoodTether,
+                 "water", "density", "not a number"},
+        BadInput{"water_nan", BadWater("seabed=-20", "seabed=nan"), kGoodTether, "water",
+                 "seabed", "not a finite number"},
+        BadInput{"water_infinity", BadWater("current=0.3,0,0", "current=inf,0,0"), kGoodTether,
+                 "water", "current", "not a finite number"},
+        BadInput{"water_negative", std::string(kGoodWater) + " seabed_friction=-1",
+                 kGoodTether, "water", "seabed_friction", "[0, 10]"},
+        BadInput{"water_zero", BadWater("density=1025", "density=0"), kGoodTether, "water",
+                 "density", "(0, 10000]"},
+        BadInput{"water_huge", BadWater("current=0.3,0,0", "current=1e6,0,0"), kGoodTether,
+                 "water", "current", "[-1000, 1000]"},
+        BadInput{"water_short_vector", BadWater("current=0.3,0,0", "current=0.3,0"),
+                 kGoodTether, "water", "current", "3 numbers"},
+        BadInput{"water_malformed", std::string(kGoodWater) + " seabed", kGoodTether,
+                 "water", "", "'seabed' is not of the form key=value"},
+        BadInput{"water_seabed_keys_without_seabed",
+                 BadWater("seabed=-20", "seabed_stiffness=1e5"), kGoodTether, "water", "seabed",
+                 "no 'seabed' height"}),
+    BadName);
+
+// MuJoCo's own checks cover names given twice (two tethers of one name, two water texts, two
+// sites of one name): exit code 2 and MuJoCo's message naming the file and the name.
+TEST(CliBadInputMuJoCo, DuplicateNamesExitWith2) {
+  const std::string path = ::testing::TempDir() + "/bad_duplicates.xml";
+  const std::string tether = std::string("<text name=\"tether:u\" data=\"") + kGoodTether + "\"/>";
+  const std::string sites = R"(<site name="a"/><site name="b" pos="8 0 0"/>)";
+  struct Case {
+    std::string custom, sites, name;
+  };
+  for (const Case& c :
+       {Case{tether + tether, sites, "tether:u"},
+        Case{"<text name=\"water\" data=\"density=1\"/><text name=\"water\" data=\"density=2\"/>" +
+                 tether,
+             sites, "water"},
+        Case{tether, sites + R"(<site name="b" pos="1 0 0"/>)", "b"}}) {
+    std::ofstream(path) << "<mujoco><custom>" << c.custom << "</custom><worldbody>" << c.sites
+                        << "</worldbody></mujoco>";
+    std::string output;
+    EXPECT_EQ(RunCli("info " + path, &output), 2) << output;
+    EXPECT_TRUE(Contains(output, path)) << output;
+    EXPECT_TRUE(Contains(output, "repeated name")) << output;
+    EXPECT_TRUE(Contains(output, "Object name = " + c.name)) << output;
+  }
+}
+
+// A file that is not MJCF, and one that does not exist.
+TEST(CliBadInputMuJoCo, MalformedXmlAndMissingFileExitWith2) {
+  const std::string path = ::testing::TempDir() + "/bad_xml.xml";
+  std::ofstream(path) << "<mujoco><custom><text name=\"tether:u\" data=\"ends=a,b\"></mujoco>";
+  std::string output;
+  EXPECT_EQ(RunCli("run " + path + " --duration 1", &output), 2) << output;
+  EXPECT_TRUE(Contains(output, path + ": XML parse error")) << output;
+  EXPECT_EQ(RunCli("run /nonexistent/model.xml --duration 1", &output), 2) << output;
+  EXPECT_TRUE(Contains(output, "/nonexistent/model.xml")) << output;
+}
+
+// The advisor's warning is printed by the command line; the run goes on (and here diverges,
+// exit code 1, with the divergence message).
+TEST(CliAdvisor, WarningIsPrintedAndDivergenceExitsWith1) {
+  const std::string path = ::testing::TempDir() + "/advisor.xml";
+  std::ofstream(path) << LineXml("integrator=explicit substeps=1");
+  std::string output;
+  EXPECT_EQ(RunCli("run " + path + " --duration 1", &output), 1) << output;
+  EXPECT_TRUE(Contains(output, "mjtether: warning: " + path + ": <text name=\"tether:line\">"))
+      << output;
+  EXPECT_TRUE(Contains(output, "tether 'line' diverged at t = ")) << output;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Concurrency
+
+std::string ReadModel(const char* file) {
+  std::ifstream f(std::string(MJTETHER_MODELS_DIR) + "/" + file);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+// A second scene with an explicit tether in a current, hanging a free vehicle.
+const char* kExplicitScene = R"(<mujoco><option timestep="0.002"/>
+  <custom><text name="water" data="current=0.5,0.2,0"/>
+    <text name="tether:t" data="ends=top,hook length=6 segments=12 diameter=0.02
+          mass_per_length=0.8 EA=1e5 EI=0.2 damping=20 Cdn=1.2 Cdt=0.02 Can=1
+          integrator=explicit"/></custom>
+  <worldbody><site name="top" pos="0 0 0"/>
+    <body name="v" pos="2 0 -5"><freejoint/><geom type="sphere" size="0.2" mass="20"/>
+      <site name="hook"/></body></worldbody></mujoco>)";
+
+// Two models and four mjData stepped from four threads at once give the same results, bit for
+// bit, as the same runs one after another (the callback keeps all state in mjData and takes
+// scratch memory from mjData's stack).
+TEST_F(Scene, FourThreadsMatchSequentialRunsBitForBit) {
+  mjModel* models[2] = {Load(ReadModel("rov_tether.xml"), "rov.xml"),
+                        Load(kExplicitScene, "explicit.xml")};
+  ASSERT_TRUE(models[0] && models[1]);
+  const int steps = 1500;
+  // Different initial velocities so that the four runs differ.
+  auto start = [&](int k) {
+    mjModel* m = models[k % 2];
+    mjData* d = Make(m);
+    d->qvel[0] = 0.1 * k;
+    return d;
+  };
+  auto run = [&](int k, mjData* d) {
+    for (int s = 0; s < steps; ++s) mj_step(models[k % 2], d);
+  };
+  std::vector<mjData*> sequential, parallel;
+  for (int k = 0; k < 4; ++k) {
+    sequential.push_back(start(k));
+    run(k, sequential.back());
+  }
+  for (int k = 0; k < 4; ++k) parallel.push_back(start(k));
+  std::vector<std::thread> threads;
+  for (int k = 0; k < 4; ++k) threads.emplace_back(run, k, parallel[k]);
+  for (std::thread& t : threads) t.join();
+  for (int k = 0; k < 4; ++k) {
+    const mjModel* m = models[k % 2];
+    const mjData* a = sequential[k];
+    const mjData* b = parallel[k];
+    EXPECT_FALSE(CheckDivergence(m, a));
+    EXPECT_EQ(std::memcmp(a->qpos, b->qpos, sizeof(mjtNum) * m->nq), 0) << "run " << k;
+    EXPECT_EQ(std::memcmp(a->qvel, b->qvel, sizeof(mjtNum) * m->nv), 0) << "run " << k;
+    EXPECT_EQ(std::memcmp(a->userdata, b->userdata, sizeof(mjtNum) * m->nuserdata), 0)
+        << "run " << k;
+  }
+  // The runs really differ from each other (so the comparison could fail).
+  EXPECT_NE(std::memcmp(sequential[0]->qpos, sequential[2]->qpos,
+                        sizeof(mjtNum) * models[0]->nq),
+            0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// A long run of the default scene: 2 simulated minutes by default, one hour with
+// MJTETHER_LONG=1 (CTest label "long").
+
+long ResidentKiB() {
+  std::ifstream f("/proc/self/statm");
+  long size = 0, resident = 0;
+  f >> size >> resident;
+  return resident * (sysconf(_SC_PAGESIZE) / 1024);
+}
+
+// Energy and tension stay bounded, and neither grows from the first half of the run (after a
+// 30 s transient) to the second: the second half's largest tension and largest tether +
+// vehicle energy are at most 10% above the first half's (the scene settles into a steady swing
+// down current, so an honest run repeats itself; a slow numerical instability would grow).
+// Tension never exceeds the energy-balance bound of the vehicle's catch (below). Memory is
+// flat: mjData's stack high-water mark does not move after the first second and the process's
+// resident size grows by less than 1 MiB.
+TEST_F(Scene, DefaultSceneLongRunIsBoundedWithFlatMemory) {
+  const char* env = std::getenv("MJTETHER_LONG");
+  const double duration = env && std::string(env) == "1" ? 3600 : 120;
+  mjModel* m = Load(ReadModel("rov_tether.xml"), "rov_tether.xml");
+  mjData* d = Make(m);
+  const int k = FindTether(m, "umbilical");
+  const Tether* t = GetTether(m, k);
+  const int rov = mj_name2id(m, mjOBJ_BODY, "rov");
+  const double M = m->body_mass[rov], g = 9.81;
+  // Catch bound: the vehicle (no buoyancy in MuJoCo 2.2) can fall at most from its start to
+  // the TMS's depth minus the tether length, h <= 18 m; energy balance against the tether's
+  // spring k = EA/L gives the stretch d with k d^2/2 = M g (h + d) and T = k d. The current
+  // also does work on the vehicle; we add a factor 1.5 for it.
+  const double kspring = t->params().EA / t->params().length, h = 18;
+  const double stretch = (M * g + std::sqrt(M * g * M * g + 2 * kspring * M * g * h)) / kspring;
+  const double tension_bound = 1.5 * kspring * stretch;
+  std::vector<double> T(t->segments());
+  double tmax[2] = {0, 0}, emax[2] = {0, 0};
+  long stack_after_1s = -1, rss_after_1s = 0;
+  while (d->time < duration) {
+    mj_step(m, d);
+    ASSERT_FALSE(CheckDivergence(m, d)) << *CheckDivergence(m, d);
+    if (stack_after_1s < 0 && d->time >= 1) {
+      stack_after_1s = d->maxuse_stack;
+      rss_after_1s = ResidentKiB();
+    }
+    if (d->time < 30) continue;
+    const int half = d->time < 30 + (duration - 30) / 2 ? 0 : 1;
+    GetTensions(m, d, k, T.data());
+    tmax[half] = std::max(tmax[half], *std::max_element(T.begin(), T.end()));
+    const double* x = NodePositions(m, d, k);
+    const double* v = NodeVelocities(m, d, k);
+    Ends ends;  // potential energy without clamps: ends unused
+    const double vehicle = 0.5 * M *
+                               (d->qvel[0] * d->qvel[0] + d->qvel[1] * d->qvel[1] +
+                                d->qvel[2] * d->qvel[2]) +
+                           M * g * d->qpos[2];
+    const double energy = t->KineticEnergy(x, v) + t->PotentialEnergy(x, ends) + vehicle;
+    // Energies are negative (below z = 0); compare magnitudes above the lowest possible state.
+    const double lowest = -M * g * (10.5 + 20 * 1.1);
+    emax[half] = std::max(emax[half], energy - lowest);
+  }
+  EXPECT_LT(tmax[0], tension_bound);
+  EXPECT_LT(tmax[1], tension_bound);
+  EXPECT_LE(tmax[1], 1.1 * tmax[0]) << "first half " << tmax[0] << " N, second " << tmax[1];
+  EXPECT_LE(emax[1], 1.1 * emax[0]) << "first half " << emax[0] << " J, second " << emax[1];
+  EXPECT_EQ(d->maxuse_stack, stack_after_1s);
+  EXPECT_LT(ResidentKiB() - rss_after_1s, 1024);
+  std::printf("simulated %.0f s: max tension %.1f / %.1f N (bound %.0f N), energy above "
+              "floor %.1f / %.1f J, stack %ld doubles, RSS %+ld KiB\n",
+              duration, tmax[0], tmax[1], tension_bound, emax[0], emax[1],
+              static_cast<long>(d->maxuse_stack), ResidentKiB() - rss_after_1s);
+}
+
+}  // namespace
+}  // namespace mjtether
