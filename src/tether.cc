@@ -93,6 +93,11 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
   Tether& c = tether;
   c.p_ = params;
   c.env_ = env;
+  // Water::seabed_friction_axial < 0 means "same as across" (params.h). Resolve it here, not
+  // only in the parser: a negative coefficient would push the line along its slip.
+  if (c.env_.water.seabed_friction_axial < 0) {
+    c.env_.water.seabed_friction_axial = c.env_.water.seabed_friction;
+  }
   c.N_ = params.segments;
   c.L0_ = params.length / c.N_;
   c.area_ = kPi * params.diameter * params.diameter / 4;
@@ -439,13 +444,15 @@ double Tether::PotentialEnergy(const double* xp, const Ends& ends) const {
     const double l = dx.norm();
     if (Has(kAxial) && l > L0_) E += 0.5 * p_.EA / L0_ * (l - L0_) * (l - L0_);
     Vec3 t = l > 0 ? Vec3(dx / l) : Vec3::Zero();
+    // Bending: the potential of the forces of AddBending is EI/w (1 - cos theta) per node
+    // (theta the turning angle, w the curvature weight), since M = EI sin(theta)/w.
     if (Has(kBending)) {
-      if (j > 0) E += 0.5 * p_.EI / L0_ * t_prev.cross(t).squaredNorm();
+      if (j > 0) E += p_.EI / L0_ * (1 - t_prev.dot(t));
       if (j == 0 && Has(kClamp) && p_.clamp_a) {
-        E += 0.5 * p_.EI / (0.5 * L0_) * ends.a.axis.cross(t).squaredNorm();
+        E += p_.EI / (0.5 * L0_) * (1 - ends.a.axis.dot(t));
       }
       if (j == N_ - 1 && Has(kClamp) && p_.clamp_b) {
-        E += 0.5 * p_.EI / (0.5 * L0_) * t.cross(ends.b.axis).squaredNorm();
+        E += p_.EI / (0.5 * L0_) * (1 - t.dot(ends.b.axis));
       }
     }
     t_prev = t;
