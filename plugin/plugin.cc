@@ -297,7 +297,7 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
   }
   // Vehicles, motions and thrust schedules (plugin/vehicles.cc) use the same callback.
   bool vehicles = false;
-  if (!AttachVehicles(m, source, env, &vehicles, error)) return false;
+  if (!AttachVehicles(m, source, env, &offset, &vehicles, error)) return false;
   if (set->tethers.empty() && !vehicles) return true;
   m->nuserdata = offset;
   m->nstack += set->work_size + 64;

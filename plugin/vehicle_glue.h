@@ -12,11 +12,12 @@
 namespace mjtether {
 
 // Reads every "vehicle:", "motion:" and "thrust:" text of m, checks it, adds the vehicles'
-// added mass to the free joints' armature and registers m. *any is set when m declares at
-// least one of them. On error nothing is registered or changed; *error is
-// "SOURCE: <text name=...>: message".
-bool AttachVehicles(mjModel* m, const std::string& source, const Environment& env, bool* any,
-                    std::string* error);
+// added mass to the free joints' armature and registers m. Each vehicle's state block is
+// taken from mjData::userdata at *offset, which is advanced (the caller sets m->nuserdata).
+// *any is set when m declares at least one of them. On error nothing is registered or changed;
+// *error is "SOURCE: <text name=...>: message".
+bool AttachVehicles(mjModel* m, const std::string& source, const Environment& env, int* offset,
+                    bool* any, std::string* error);
 
 // Forgets m's vehicles, motions and schedules.
 void DetachVehicles(const mjModel* m);

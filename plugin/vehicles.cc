@@ -22,6 +22,16 @@ struct AttachedVehicle {
   int body = -1;
   int dof = -1;      // first dof of the body's free joint
   Vehicle vehicle;
+  int offset = 0;    // start of this vehicle's block in mjData::userdata
+};
+
+// Layout of one vehicle's block in mjData::userdata (mj_resetData zeroes it).
+enum VehicleSlot : int {
+  kSet = 0,      // 1 once the velocity below is recorded
+  kTime,         // [s] time of the recorded velocity
+  kVel,          // [m/s] world velocity of the body origin at kTime (3)
+  kAcc = kVel + 3,  // [m/s^2] its finite difference over the last step (3)
+  kVehicleBlock = kAcc + 3,
 };
 
 struct AttachedMotion {
@@ -63,8 +73,8 @@ constexpr double kSamePosition = 1e-9;
 
 }  // namespace
 
-bool AttachVehicles(mjModel* m, const std::string& source, const Environment& env, bool* any,
-                    std::string* error) {
+bool AttachVehicles(mjModel* m, const std::string& source, const Environment& env, int* offset,
+                    bool* any, std::string* error) {
   *any = false;
   std::string element;
   auto fail = [&](const std::string& message) {
@@ -103,7 +113,7 @@ bool AttachVehicles(mjModel* m, const std::string& source, const Environment& en
       std::string message;
       std::optional<Vehicle> v = Vehicle::Create(*p, env, m->body_subtreemass[b], &message);
       if (!v) return fail(message);
-      set->vehicles.push_back({name, b, m->jnt_dofadr[j], *v});
+      set->vehicles.push_back({name, b, m->jnt_dofadr[j], *v, 0});
     } else if (kind == "motion") {
       const int b = mj_name2id(m, mjOBJ_BODY, name.c_str());
       if (b < 0) return fail("no body named '" + name + "' in the model");
@@ -128,6 +138,10 @@ bool AttachVehicles(mjModel* m, const std::string& source, const Environment& en
   }
   *any = !set->vehicles.empty() || !set->motions.empty() || !set->schedules.empty();
   if (!*any) return true;
+  for (AttachedVehicle& av : set->vehicles) {
+    av.offset = *offset;
+    *offset += kVehicleBlock;
+  }
   // Added mass into the free joints' armature: world-frame translation dofs take the isotropic
   // part, body-frame rotation dofs the rotational diagonal (see vehicle.h).
   for (const AttachedVehicle& av : set->vehicles) {
@@ -173,8 +187,23 @@ void ApplyVehicles(const mjModel* m, mjData* d) {
     const Vec6 nu_r = veh.RelativeVelocity(R, v, w);
     Wrench tau = veh.Damping(nu_r);
     if (veh.has_added_mass()) {
-      // Body-frame derivative of v_r from the last computed acceleration (the lag term).
-      const Vec3 a(d->qacc + av.dof);
+      // The world acceleration over the last step, from the velocities at the last two
+      // callback times (with Euler and implicit: the previous step's qacc). A second call at
+      // the same time reuses it, so repeated mj_forward calls change nothing.
+      double* u = d->userdata + av.offset;
+      if (u[kSet] == 0 || d->time < u[kTime]) {
+        u[kSet] = 1;
+        u[kTime] = d->time;
+        for (int i = 0; i < 3; ++i) u[kVel + i] = v[i], u[kAcc + i] = 0;
+      } else if (d->time > u[kTime]) {
+        for (int i = 0; i < 3; ++i) {
+          u[kAcc + i] = (v[i] - u[kVel + i]) / (d->time - u[kTime]);
+          u[kVel + i] = v[i];
+        }
+        u[kTime] = d->time;
+      }
+      const Vec3 a(u + kAcc);
+      // Body-frame derivative of v_r (the lagged term).
       const Vec3 dv_r = R.transpose() * a - w.cross(nu_r.head<3>());
       const Wrench am = veh.AddedMass(nu_r, dv_r);
       tau.force += am.force;
