@@ -8,7 +8,6 @@
 // Frame k shows the state at step round(k / (fps h)), h the model's timestep: frames are
 // scheduled by index, so they never drift from t = k/fps by more than h/2 however long the
 // video. The video has floor(duration * fps) frames and lasts `duration` seconds.
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -26,6 +25,8 @@
 #include <vector>
 
 #include "cli_command.h"
+#include "cli_pipe.h"
+#include "cli_step.h"
 #include "mjtether.h"
 #include "render.h"
 
@@ -45,76 +46,6 @@ struct RenderCliOptions {
   bool no_hud = false;
 };
 
-// ffmpeg reading raw RGB frames on its stdin: started with fork/exec (no shell, so any file
-// name works), closed with its exit status checked.
-class FfmpegPipe {
- public:
-  bool Open(const std::string& out, int width, int height, double fps, std::string* error) {
-    int fds[2];
-    if (pipe(fds) != 0) {
-      *error = std::string("pipe: ") + std::strerror(errno);
-      return false;
-    }
-    const std::string size = std::to_string(width) + "x" + std::to_string(height);
-    char rate[32];
-    std::snprintf(rate, sizeof(rate), "%.9g", fps);
-    std::vector<std::string> args = {
-        "ffmpeg", "-hide_banner", "-loglevel", "error",    "-y",      "-f", "rawvideo", "-pix_fmt",
-        "rgb24",  "-s",           size,        "-r",       rate,      "-i", "-",        "-vf",
-        "vflip",  "-c:v",         "libx264",   "-pix_fmt", "yuv420p", "-r", rate,       out};
-    pid_ = fork();
-    if (pid_ < 0) {
-      *error = std::string("fork: ") + std::strerror(errno);
-      return false;
-    }
-    if (pid_ == 0) {
-      dup2(fds[0], 0);
-      close(fds[0]);
-      close(fds[1]);
-      std::vector<char*> argv;
-      for (std::string& a : args) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      execvp("ffmpeg", argv.data());
-      std::fprintf(stderr, "mjtether: cannot run ffmpeg: %s\n", std::strerror(errno));
-      _exit(127);
-    }
-    close(fds[0]);
-    fd_ = fds[1];
-    return true;
-  }
-
-  bool Write(const unsigned char* data, size_t n) {
-    while (n > 0) {
-      const ssize_t w = write(fd_, data, n);
-      if (w < 0) {
-        if (errno == EINTR) continue;
-        return false;
-      }
-      data += w;
-      n -= static_cast<size_t>(w);
-    }
-    return true;
-  }
-
-  // Closes the pipe and waits; returns ffmpeg's exit status (127: not found), or -1.
-  int Close() {
-    if (fd_ >= 0) close(fd_);
-    fd_ = -1;
-    if (pid_ <= 0) return -1;
-    int status = 0;
-    while (waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
-    }
-    pid_ = -1;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  }
-
-  ~FfmpegPipe() { Close(); }
-
- private:
-  int fd_ = -1;
-  pid_t pid_ = -1;
-};
-
 bool ParseSize(const std::string& s, int* w, int* h) {
   char x = 0, extra = 0;
   return std::sscanf(s.c_str(), "%d%c%d%c", w, &x, h, &extra) == 3 && (x == 'x' || x == 'X');
@@ -122,7 +53,8 @@ bool ParseSize(const std::string& s, int* w, int* h) {
 
 // Largest tension of any segment or end over the frames' instants, to fix the colour scale
 // before rendering. Returns nullopt if the simulation diverges (the message is printed).
-std::optional<double> TensionPrepass(const mjModel* m, long long nframes, double fps) {
+std::optional<double> TensionPrepass(const mjModel* m, const std::string& model, long long nframes,
+                                     double fps) {
   mjData* d = mj_makeData(m);
   const double h = m->opt.timestep;
   std::vector<double> T;
@@ -132,8 +64,7 @@ std::optional<double> TensionPrepass(const mjModel* m, long long nframes, double
   for (long long k = 0; k < nframes && ok; ++k) {
     const long long target = mjtether::render::FrameStep(k, fps, h);
     for (; step < target; ++step) {
-      mj_step(m, d);
-      if (std::optional<std::string> diverged = mjtether::CheckDivergence(m, d)) {
+      if (std::optional<std::string> diverged = mjtether::cli::StepAndCheck(m, d, model)) {
         std::cerr << "mjtether: " << *diverged << "\n";
         ok = false;
         break;
@@ -223,7 +154,7 @@ int Render(const RenderCliOptions& opt) {
   if (opt.tension_max > 0) {
     ropt.tension_max = opt.tension_max;
   } else {
-    std::optional<double> tmax = TensionPrepass(m, nframes, opt.fps);
+    std::optional<double> tmax = TensionPrepass(m, opt.model, nframes, opt.fps);
     if (!tmax) return 1;
     ropt.tension_max = mjtether::render::NiceCeil(*tmax);
   }
@@ -237,8 +168,16 @@ int Render(const RenderCliOptions& opt) {
   const int W = ropt.width, H = ropt.height;
 
   std::signal(SIGPIPE, SIG_IGN);  // a dead ffmpeg shows up as a failed write, not a signal
-  FfmpegPipe ffmpeg;
-  if (!opt.video.empty() && !ffmpeg.Open(opt.video, W, H, opt.fps, &error)) {
+  const std::string size = std::to_string(W) + "x" + std::to_string(H);
+  char rate[32];
+  std::snprintf(rate, sizeof(rate), "%.9g", opt.fps);
+  mjtether::cli::ChildPipe ffmpeg;
+  if (!opt.video.empty() &&
+      !ffmpeg.Open({"ffmpeg",   "-hide_banner", "-loglevel", "error", "-y",    "-f",
+                    "rawvideo", "-pix_fmt",     "rgb24",     "-s",    size,    "-r",
+                    rate,       "-i",           "-",         "-vf",   "vflip", "-c:v",
+                    "libx264",  "-pix_fmt",     "yuv420p",   "-r",    rate,    opt.video},
+                   &error)) {
     std::cerr << "mjtether: cannot start ffmpeg: " << error << "\n";
     return 4;
   }
@@ -254,8 +193,7 @@ int Render(const RenderCliOptions& opt) {
     // Frame k at step round(k / (fps h)).
     const long long target = mjtether::render::FrameStep(k, opt.fps, h);
     for (; step < target; ++step) {
-      mj_step(m, d);
-      if (std::optional<std::string> diverged = mjtether::CheckDivergence(m, d)) {
+      if (std::optional<std::string> diverged = mjtether::cli::StepAndCheck(m, d, opt.model)) {
         std::cerr << (progress ? "\n" : "") << "mjtether: " << *diverged << "\n";
         status = 1;
         break;

@@ -364,5 +364,31 @@ TEST_F(RenderCli, FfmpegFailureIsExitCode4AndBadSizeIs2) {
   EXPECT_NE(bad.find("even"), std::string::npos) << bad;
 }
 
+TEST_F(RenderCli, PlotFromARunLogAndFromTheModelWritesAPngOfTheAskedSize) {
+  if (!Have("gnuplot")) GTEST_SKIP() << "gnuplot is not installed: cannot plot";
+  const std::string log = (dir_ / "log.csv").string();
+  int status = 0;
+  Shell(cli_ + " run " + model_ + " --duration 1 --log " + log + " 2>&1", &status);
+  ASSERT_EQ(status, 0);
+  const std::string from_log = (dir_ / "from_log.png").string();
+  const std::string out =
+      Shell(cli_ + " plot " + log + " --out " + from_log + " --size 800x600 2>&1", &status);
+  EXPECT_EQ(status, 0) << out;
+  EXPECT_EQ(PngSize(from_log), (std::array<int, 2>{800, 600}));
+  const std::string from_model = (dir_ / "from_model.png").string();
+  Shell(cli_ + " plot " + model_ + " --duration 1 --out " + from_model + " 2>&1", &status);
+  EXPECT_EQ(status, 0);
+  EXPECT_EQ(PngSize(from_model), (std::array<int, 2>{1000, 700}));
+
+  // A CSV without the tension columns is bad input, named in the message.
+  const std::string bad = (dir_ / "bad.csv").string();
+  std::ofstream(bad) << "time,x\n0,1\n";
+  const std::string message =
+      Shell(cli_ + " plot " + bad + " --out " + (dir_ / "bad.png").string() + " 2>&1", &status);
+  EXPECT_EQ(status, 2);
+  EXPECT_NE(message.find("bad.csv"), std::string::npos) << message;
+  EXPECT_NE(message.find("tension_A"), std::string::npos) << message;
+}
+
 }  // namespace
 }  // namespace mjtether::render

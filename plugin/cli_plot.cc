@@ -1,0 +1,275 @@
+// `mjtether plot`: a PNG (gnuplot) of the tension at both ends of a tether and the vehicle's
+// depth over time, from a `mjtether run --log` CSV or by running the model.
+//
+//   mjtether plot INPUT --out FILE.png [--duration S] [--every S] [--tether NAME] [--body NAME]
+//       [--size 1000x700]
+//
+// INPUT ending in .csv is read as a run log (columns time, NAME.tension_A, NAME.tension_B,
+// BODY.z); otherwise it is a model, run for --duration seconds and sampled every --every
+// seconds (scheduled by step index, as `mjtether run` does).
+#include <algorithm>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli_command.h"
+#include "cli_pipe.h"
+#include "cli_step.h"
+#include "mjtether.h"
+#include "render.h"
+
+namespace {
+
+struct PlotOptions {
+  std::string input;
+  std::string out;
+  double duration = 0;
+  double every = 0.05;
+  std::string tether;
+  std::string body;
+  std::string size = "1000x700";
+};
+
+// The series to plot: time [s], tension at ends A and B [N], vehicle height z [m].
+struct Series {
+  std::string title;
+  std::string label_a = "end A", label_b = "end B", vehicle;
+  std::vector<double> t, ta, tb, z;
+};
+
+bool EndsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+std::vector<std::string> SplitCsv(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream ss(line);
+  std::string item;
+  while (std::getline(ss, item, ',')) out.push_back(item);
+  return out;
+}
+
+// Reads a run log. Returns false with *error naming the file and the missing column.
+bool ReadLog(const PlotOptions& opt, Series* s, std::string* error) {
+  std::ifstream f(opt.input);
+  std::string line;
+  if (!f || !std::getline(f, line)) {
+    *error = opt.input + ": cannot read the header line";
+    return false;
+  }
+  const std::vector<std::string> head = SplitCsv(line);
+  auto find = [&](const std::string& name) {
+    return static_cast<int>(std::find(head.begin(), head.end(), name) - head.begin());
+  };
+  auto find_suffix = [&](const std::string& suffix) -> std::string {
+    for (const std::string& h : head) {
+      if (EndsWith(h, suffix)) return h.substr(0, h.size() - suffix.size());
+    }
+    return "";
+  };
+  const std::string tether = opt.tether.empty() ? find_suffix(".tension_A") : opt.tether;
+  const std::string body = opt.body.empty() ? find_suffix(".z") : opt.body;
+  const int ct = find("time"), ca = find(tether + ".tension_A"), cb = find(tether + ".tension_B");
+  const int cz = body.empty() ? -1 : find(body + ".z");
+  const int n = static_cast<int>(head.size());
+  if (ct >= n || ca >= n || cb >= n || tether.empty()) {
+    *error = opt.input + ": no columns time, " + (tether.empty() ? "NAME" : tether) +
+             ".tension_A and .tension_B (write the log with mjtether run --log)";
+    return false;
+  }
+  if (!opt.body.empty() && cz >= n) {
+    *error = opt.input + ": --body " + opt.body + ": no column " + opt.body + ".z";
+    return false;
+  }
+  s->title = tether + " (" + opt.input + ")";
+  s->label_a = tether + ": tension at end A";
+  s->label_b = tether + ": tension at end B";
+  s->vehicle = cz < n ? body : "";
+  int row = 1;
+  while (std::getline(f, line)) {
+    ++row;
+    if (line.empty()) continue;
+    const std::vector<std::string> v = SplitCsv(line);
+    try {
+      s->t.push_back(std::stod(v.at(ct)));
+      s->ta.push_back(std::stod(v.at(ca)));
+      s->tb.push_back(std::stod(v.at(cb)));
+      s->z.push_back(cz < n ? std::stod(v.at(cz)) : 0.0);
+    } catch (const std::exception&) {
+      *error = opt.input + ": line " + std::to_string(row) + ": not a number in a needed column";
+      return false;
+    }
+  }
+  return true;
+}
+
+std::string BodyName(const mjModel* m, int b) {
+  if (b < 0) return "free end";
+  const char* name = mj_id2name(m, mjOBJ_BODY, b);
+  return name && *name ? name : "body " + std::to_string(b);
+}
+
+// Runs the model and samples it. Returns 0, or the exit code (1 diverged, 2 bad input).
+int RunModel(const PlotOptions& opt, Series* s) {
+  std::string error;
+  mjModel* m = mjtether::LoadModel(opt.input, &error);
+  if (!m) {
+    std::cerr << "mjtether: " << error << "\n";
+    return 2;
+  }
+  int status = 0;
+  const int k = opt.tether.empty() ? 0 : mjtether::FindTether(m, opt.tether);
+  int vehicle =
+      opt.body.empty() ? mjtether::render::Vehicle(m) : mj_name2id(m, mjOBJ_BODY, opt.body.c_str());
+  if (mjtether::TetherCount(m) == 0 || k < 0) {
+    std::cerr << "mjtether: " << opt.input << ": "
+              << (k < 0 ? "no tether named '" + opt.tether + "'" : "no tether declared") << "\n";
+    status = 2;
+  } else if (!opt.body.empty() && vehicle < 0) {
+    std::cerr << "mjtether: " << opt.input << ": --body " << opt.body << ": no such body\n";
+    status = 2;
+  } else if (!(opt.duration > 0)) {
+    std::cerr << "mjtether: plot " << opt.input << ": give --duration S to run the model\n";
+    status = 2;
+  }
+  if (status) {
+    mjtether::Detach(m);
+    mj_deleteModel(m);
+    return status;
+  }
+  const std::string name = mjtether::TetherName(m, k);
+  s->title = name + " (" + opt.input + ")";
+  s->label_a = name + ": tension at " + BodyName(m, mjtether::EndBody(m, k, 0));
+  s->label_b = name + ": tension at " + BodyName(m, mjtether::EndBody(m, k, 1));
+  s->vehicle = vehicle >= 0 ? BodyName(m, vehicle) : "";
+
+  mjData* d = mj_makeData(m);
+  const double h = m->opt.timestep;
+  const long long steps = std::llround(opt.duration / h);
+  const double every = std::max(opt.every, h);
+  long long next = 0, index = 0;
+  for (long long i = 0;; ++i) {
+    if (i == next) {
+      mj_forward(m, d);
+      const mjtether::EndReactions r = mjtether::GetReactions(m, d, k);
+      s->t.push_back(d->time);
+      s->ta.push_back(r.tension_a);
+      s->tb.push_back(r.tension_b);
+      s->z.push_back(vehicle >= 0 ? d->xpos[3 * vehicle + 2] : 0.0);
+      next = std::llround(++index * every / h);
+    }
+    if (i == steps) break;
+    if (std::optional<std::string> diverged = mjtether::cli::StepAndCheck(m, d, opt.input)) {
+      std::cerr << "mjtether: " << *diverged << "\n";
+      status = 1;
+      break;
+    }
+  }
+  mj_deleteData(d);
+  mjtether::Detach(m);
+  mj_deleteModel(m);
+  return status;
+}
+
+// A string in gnuplot's single quotes (a quote is doubled).
+std::string Quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("''") : std::string(1, c);
+  return q + "'";
+}
+
+int Plot(const PlotOptions& opt) {
+  int W = 0, H = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(opt.size.c_str(), "%d%c%d%c", &W, &x, &H, &extra) != 3 || x != 'x' || W < 200 ||
+      H < 200 || W > 8000 || H > 8000) {
+    std::cerr << "mjtether: --size " << opt.size
+              << ": expected WIDTHxHEIGHT, each in [200, 8000]\n";
+    return 2;
+  }
+  Series s;
+  if (EndsWith(opt.input, ".csv")) {
+    std::string error;
+    if (!ReadLog(opt, &s, &error)) {
+      std::cerr << "mjtether: " << error << "\n";
+      return 2;
+    }
+  } else if (const int status = RunModel(opt, &s); status != 0) {
+    return status;
+  }
+  if (s.t.empty()) {
+    std::cerr << "mjtether: " << opt.input << ": no samples to plot\n";
+    return 2;
+  }
+
+  // Two panels sharing the time axis: end tensions, then the vehicle's depth (-z, downwards).
+  std::ostringstream g;
+  g.precision(9);
+  g << "$data << EOD\n";
+  for (size_t i = 0; i < s.t.size(); ++i) {
+    g << s.t[i] << " " << s.ta[i] << " " << s.tb[i] << " " << -s.z[i] << "\n";
+  }
+  g << "EOD\n"
+    << "set terminal pngcairo size " << W << "," << H << " font 'sans,11'\n"
+    << "set output " << Quote(opt.out) << "\n"
+    << "set multiplot layout " << (s.vehicle.empty() ? 1 : 2) << ",1 title " << Quote(s.title)
+    << " noenhanced\n"
+    << "set grid\nset key top right noenhanced\nset lmargin 12\n"
+    << "set ylabel 'tension [N]'\n"
+    << (s.vehicle.empty() ? "set xlabel 'time [s]'\n" : "")
+    << "plot $data using 1:2 with lines lw 2 lc rgb '#1f77b4' title " << Quote(s.label_a)
+    << ", $data using 1:3 with lines lw 2 lc rgb '#d62728' title " << Quote(s.label_b) << "\n";
+  if (!s.vehicle.empty()) {
+    g << "set xlabel 'time [s]'\nset ylabel 'depth [m]'\nset yrange [*:*] reverse\n"
+      << "plot $data using 1:4 with lines lw 2 lc rgb '#2ca02c' title "
+      << Quote("depth of " + s.vehicle) << "\n";
+  }
+  g << "unset multiplot\nset output\n";
+
+  std::signal(SIGPIPE, SIG_IGN);
+  mjtether::cli::ChildPipe gnuplot;
+  std::string error;
+  if (!gnuplot.Open({"gnuplot"}, &error)) {
+    std::cerr << "mjtether: cannot start gnuplot: " << error << "\n";
+    return 4;
+  }
+  const bool written = gnuplot.Write(g.str());
+  const int rc = gnuplot.Close();
+  std::ifstream png(opt.out, std::ios::binary | std::ios::ate);
+  if (!written || rc != 0 || !png || png.tellg() <= 0) {
+    std::cerr << "mjtether: gnuplot failed (exit status " << rc
+              << (rc == 127 ? ": gnuplot not found on PATH" : "") << ") writing " << opt.out
+              << "\n";
+    return 4;
+  }
+  std::cerr << "mjtether: plotted " << s.t.size() << " samples to " << opt.out << "\n";
+  return 0;
+}
+
+std::function<int()> SetupPlot(CLI::App* sub) {
+  auto opt = std::make_shared<PlotOptions>();
+  sub->add_option("input", opt->input, "run log (.csv from mjtether run --log) or MJCF model")
+      ->required()
+      ->check(CLI::ExistingFile);
+  sub->add_option("--out", opt->out, "PNG file to write")->required();
+  sub->add_option("--duration", opt->duration, "simulated time when INPUT is a model [s]")
+      ->check(CLI::Range(0.0, 1e7));
+  sub->add_option("--every", opt->every, "sampling interval when INPUT is a model [s]")
+      ->check(CLI::Range(1e-9, 1e7));
+  sub->add_option("--tether", opt->tether, "tether to plot (default: the first)");
+  sub->add_option("--body", opt->body, "body whose depth is plotted (default: the vehicle)");
+  sub->add_option("--size", opt->size, "WIDTHxHEIGHT in pixels (default 1000x700)");
+  return [opt]() { return Plot(*opt); };
+}
+
+const bool registered = mjtether::cli::Register(
+    {"plot", "plot end tensions and vehicle depth over time (PNG, gnuplot)", SetupPlot});
+
+}  // namespace
