@@ -115,6 +115,23 @@ EndState LoadEnd(const double* src) {
   return e;
 }
 
+// An end teleported by the user (qpos or mocap_pos set by hand): since the last call it moved
+// farther than its velocity then explains, by more than max_strain segment lengths. No tether
+// can follow that within max_strain, so the tether restarts from its initial shape instead of
+// being reported as diverged. (A real end that accelerates at a would need a dt^2/2 > that.)
+bool Teleported(const AttachedTether& at, const Ends& now, const double* u, double time) {
+  const double dt = time - u[kTime];
+  if (u[kInitialized] == 0 || !(dt > 0)) return false;
+  const double jump = at.tether.params().max_strain * at.tether.rest_segment_length();
+  for (int end = 0; end < 2; ++end) {
+    if (at.site[end] < 0) continue;
+    const double* stored = u + (end == 0 ? kEndA : kEndB);
+    const Vec3& pos = end == 0 ? now.a.pos : now.b.pos;
+    if ((pos - Vec3(stored) - dt * Vec3(stored + 3)).norm() > jump) return true;
+  }
+  return false;
+}
+
 // One tether at one callback: initialise or advance to d->time, then apply the reactions.
 void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* work) {
   double* u = d->userdata + at.offset;
@@ -127,8 +144,9 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
   now.a = SiteState(m, d, at, 0, u);
   if (!free_end) now.b = SiteState(m, d, at, 1, u);
 
-  if (u[kInitialized] == 0 || d->time < u[kTime]) {
-    // First call, reset, or time went back: start again from the declared initial shape.
+  if (u[kInitialized] == 0 || d->time < u[kTime] || Teleported(at, now, u, d->time)) {
+    // First call, reset, time went back, or an end was teleported: start again from the
+    // declared initial shape.
     tether.InitialShape(now, x, v);
     u[kInitialized] = 1;
     u[kTime] = d->time;

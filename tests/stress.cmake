@@ -16,3 +16,7 @@ add_test(NAME long.DefaultSceneOneHour
          COMMAND robust_test --gtest_filter=Scene.DefaultSceneLongRunIsBoundedWithFlatMemory)
 set_tests_properties(long.DefaultSceneOneHour PROPERTIES
   LABELS long ENVIRONMENT MJTETHER_LONG=1 TIMEOUT 1800)
+
+add_executable(stress_test stress_test.cc)
+target_link_libraries(stress_test PRIVATE mjtether_plugin GTest::gtest_main)
+gtest_discover_tests(stress_test DISCOVERY_TIMEOUT 60)
