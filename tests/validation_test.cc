@@ -639,6 +639,56 @@ TEST(Validation, CriticalAngleInCurrent) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// 9. Terminal sinking speed of a horizontal heavy tether: normal drag balances the wet weight,
+// 1/2 rho Cdn d V^2 = w, V = sqrt(2 w/(rho Cdn d)) (Morison drag). The line starts
+// horizontal, every node sinking at the reference V, end A lowered at V, end B free. It keeps
+// sinking at V, horizontal, only if V is the terminal speed (otherwise the free nodes speed up
+// or slow down relative to A); the force needed to lower end A is the whole line's drag minus
+// its weight, L (k V^2 - w), zero exactly at V (a 1% error in V would show as 2% of w L).
+// The lumped drag and weight are in the same proportion at every node, so the discrete
+// terminal speed is exact: tolerances at round-off level over 5 s (1e-9 V on every node's
+// speed, 1e-9 w L on the force at A). Started from rest with A prescribed, the line would not
+// stay horizontal: in the frame sinking at V the net load vanishes and nothing restores a tilt
+// (the transient tilts it and it ends hanging from A).
+TEST(Validation, TerminalSinkingSpeed) {
+  const double rho = 1025, d = 0.02, Cdn = 1.2, mu = 1, L = 10;
+  const double w = (mu - rho * kPi * d * d / 4) * kG, V = std::sqrt(2 * w / (rho * Cdn * d));
+  Environment env = Water(rho);
+  TetherParams p;
+  p.length = L;
+  p.segments = 20;
+  p.diameter = d;
+  p.mass_per_length = mu;
+  p.EA = 1e4;
+  p.Cdn = Cdn;
+  p.Cdt = 0.01;
+  p.free_end = true;
+  Sim s(Make(p, env));
+  for (int i = 0; i <= 20; ++i) s.set(i, Vec3(L * i / 20, 0, 0)), s.set_vel(i, Vec3(0, 0, -V));
+  s.ends.a.vel = Vec3(0, 0, -V);
+  const double h = 0.01;
+  for (int k = 0; k < 500; ++k) {
+    Ends to = s.ends;
+    to.a.pos.z() = -V * (k + 1) * h;
+    ASSERT_TRUE(s.Move(to, h).ok);
+  }
+  double worst = 0, tilt = 0;
+  for (int i = 0; i <= 20; ++i) {
+    worst = std::max(worst, std::abs(-s.vel(i).z() / V - 1));
+    tilt = std::max(tilt, std::abs(s.node(i).z() - s.node(0).z()));
+  }
+  const double force = s.Reactions().force_a.norm();
+  EXPECT_LT(worst, 1e-9);
+  EXPECT_LT(force, 1e-9 * w * L);
+  EXPECT_LT(tilt, 1e-9 * L);
+  Record(0, {"9. Terminal sinking speed of a horizontal tether (d 0.02 m, Cdn 1.2, wet weight "
+             "6.65 N/m): every node's speed, end A lowered at V",
+             "√(2w/(ρ Cdn d)) " + Format("%.5f m/s", V),
+             Format("%.5f m/s", -s.vel(20).z()), Format("%.2g (worst node)", worst),
+             "1e-9 on speeds; force at A 1e-9 w L", "exact (no discretisation error)", 20});
+}
+
+// ---------------------------------------------------------------------------------------------
 // 10 (second part). Axial wave speed c = sqrt(EA/mu): end A is jerked away from B with a
 // velocity ramp 0 -> V over tau; the tension at the fixed end B (where the wave reflects and
 // doubles, to 2 sqrt(EA mu) V) crosses half its plateau at L/c + tau/2. The lumped chain
