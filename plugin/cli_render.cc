@@ -280,7 +280,7 @@ std::function<int()> SetupRender(CLI::App* sub) {
       ->check(CLI::Range(0, 16));
   sub->add_option("--tension-max", opt->tension_max,
                   "top of the tension colour scale [N]; default: the run's largest tension "
-                  "rounded up to 1, 2 or 5 x 10^k")
+                  "rounded up to 1, 2, 3, 4, 5, 6 or 8 x 10^k")
       ->check(CLI::Range(0.0, 1e12));
   sub->add_option("--vehicle", opt->vehicle, "body whose depth the HUD shows");
   sub->add_flag("--no-hud", opt->no_hud, "no text overlay or colour scale");

@@ -60,7 +60,7 @@ double DrawnRadius(const Tether& t) {
 double NiceCeil(double x) {
   if (!(x > 0) || !std::isfinite(x)) return 1;
   const double p = std::pow(10.0, std::floor(std::log10(x)));
-  for (double f : {1.0, 2.0, 5.0, 10.0}) {
+  for (double f : {1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0}) {
     if (f * p >= x * (1 - 1e-12)) return f * p;
   }
   return 10 * p;
@@ -253,21 +253,22 @@ Renderer::~Renderer() {
   if (osmesa_) OSMesaDestroyContext(static_cast<OSMesaContext>(osmesa_));
 }
 
-// The follow camera looks at the point midway between the vehicle and the centre of the
-// tether's nodes (the tether's centre alone without a vehicle).
+// The follow camera looks at the centre of the box that bounds the tethers' nodes and the
+// vehicle: it moves with the vehicle and keeps the whole tether in view.
 void Renderer::PlaceCamera(const mjModel* m, const mjData* d) {
   if (cam_.type != mjCAMERA_FREE) return;
-  Vec3 centre = Vec3::Zero();
-  int n = 0;
+  Vec3 lo = Vec3::Constant(mjMAXVAL), hi = Vec3::Constant(-mjMAXVAL);
+  auto add = [&](const double* p) {
+    lo = lo.cwiseMin(Vec3(p));
+    hi = hi.cwiseMax(Vec3(p));
+  };
   for (int k = 0; k < TetherCount(m); ++k) {
     const double* x = NodePositions(m, d, k);
     if (!x) continue;
-    for (int i = 0; i < GetTether(m, k)->nodes(); ++i, ++n) centre += Vec3(x + 3 * i);
+    for (int i = 0; i < GetTether(m, k)->nodes(); ++i) add(x + 3 * i);
   }
-  Vec3 lookat = n > 0 ? Vec3(centre / n) : Vec3(m->stat.center);
-  if (vehicle_ >= 0)
-    lookat =
-        n > 0 ? Vec3(0.5 * (lookat + Vec3(d->xpos + 3 * vehicle_))) : Vec3(d->xpos + 3 * vehicle_);
+  if (vehicle_ >= 0) add(d->xpos + 3 * vehicle_);
+  const Vec3 lookat = lo.x() <= hi.x() ? Vec3(0.5 * (lo + hi)) : Vec3(m->stat.center);
   for (int i = 0; i < 3; ++i) cam_.lookat[i] = lookat[i];
 }
 
@@ -335,7 +336,6 @@ void Renderer::Decorate(const mjModel* m, const mjData* d) {
       const Vec3 a = c - 0.5 * len * dir, b = c + 0.5 * len * dir;
       mjv_initGeom(g, mjGEOM_ARROW, nullptr, nullptr, nullptr, kArrow);
       mjv_makeConnector(g, mjGEOM_ARROW, 0.012 * D, a.x(), a.y(), a.z(), b.x(), b.y(), b.z());
-      std::snprintf(g->label, sizeof(g->label), "current %.2f m/s", speed);
       FinishDecor(g, &scn_);
     }
   }
@@ -365,6 +365,11 @@ void Renderer::DrawHud(const mjModel* m, const mjData* d) {
       values += buf;
       titles += "\naltitude";
     }
+  }
+  if (TetherCount(m) > 0 && GetTether(m, 0)->env().water.current.norm() > 0) {
+    std::snprintf(buf, sizeof(buf), "\n%.2f m/s", GetTether(m, 0)->env().water.current.norm());
+    values += buf;
+    titles += "\ncurrent (white arrow)";
   }
   mjr_overlay(mjFONT_NORMAL, mjGRID_TOPLEFT, view, titles.c_str(), values.c_str(), &con_);
 

@@ -41,8 +41,8 @@ struct RenderOptions {
   bool draw_tethers = true;  // draw the tethers (tests compare with and without)
 };
 
-// A "nice" upper bound for a colour scale: the smallest 1, 2 or 5 times a power of ten that is
-// at least x (x > 0); 1 for x <= 0.
+// A "nice" upper bound for a colour scale with ticks at quarters: the smallest 1, 2, 3, 4, 5, 6
+// or 8 times a power of ten that is at least x (x > 0); 1 for x <= 0.
 double NiceCeil(double x);
 
 // The step at which frame k of a video at `fps` frames per second is taken, for a timestep h

@@ -253,11 +253,12 @@ TEST(TensionColor, SlackIsGreyAndTheRampRunsBlueToRed) {
   for (int i = 0; i < 4; ++i) EXPECT_EQ(top[i], above[i]);
 }
 
-TEST(NiceCeil, RoundsUpToOneTwoOrFiveTimesAPowerOfTen) {
-  EXPECT_DOUBLE_EQ(NiceCeil(0.3), 0.5);
+TEST(NiceCeil, RoundsUpToOneToEightTimesAPowerOfTen) {
+  EXPECT_DOUBLE_EQ(NiceCeil(0.3), 0.3);
   EXPECT_DOUBLE_EQ(NiceCeil(200), 200);
-  EXPECT_DOUBLE_EQ(NiceCeil(201), 500);
-  EXPECT_DOUBLE_EQ(NiceCeil(501), 1000);
+  EXPECT_DOUBLE_EQ(NiceCeil(245), 300);
+  EXPECT_DOUBLE_EQ(NiceCeil(601), 800);
+  EXPECT_DOUBLE_EQ(NiceCeil(801), 1000);
   EXPECT_DOUBLE_EQ(NiceCeil(0), 1);
 }
 
