@@ -67,7 +67,9 @@ Wrench Vehicle::AddedMass(const Vec6& nu_r, const Vec3& dv_r) const {
   const Vec3 vr = nu_r.head<3>(), w = nu_r.tail<3>();
   const Vec3 Av = p_.added_mass.head<3>().cwiseProduct(vr);  // A_v v_r [kg m/s]
   const Vec3 Aw = p_.added_mass.tail<3>().cwiseProduct(w);   // A_w w [kg m^2/s]
-  f.force = -dA_.cwiseProduct(dv_r) - w.cross(dA_.cwiseProduct(vr));
+  f.force = -dA_.cwiseProduct(dv_r);
+  if (!p_.coriolis) return f;
+  f.force -= w.cross(dA_.cwiseProduct(vr));
   f.torque = -vr.cross(Av) - w.cross(Aw);
   return f;
 }

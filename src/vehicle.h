@@ -46,6 +46,10 @@ struct VehicleParams {
   Vec6 added_mass = Vec6::Zero();        // [kg, kg m^2] A1..A6
   Vec6 linear_damping = Vec6::Zero();    // [N s/m, N m s] D_l
   Vec6 quadratic_damping = Vec6::Zero();  // [N s^2/m^2, N m s^2] D_q
+  // Include the added mass's Coriolis/centripetal terms C_A(nu_r) nu_r (the Munk moment
+  // v_r x A_v v_r, w x A_v v_r, w x A_w w). Off: only the isotropic part's, which the armature
+  // carries in the world frame, remains.
+  bool coriolis = true;
 };
 
 // Body-frame force [N] and moment [N m] about the body origin.

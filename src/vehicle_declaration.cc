@@ -60,8 +60,9 @@ std::string UnknownKey(const std::string& key, const std::vector<const char*>& a
 }  // namespace
 
 std::optional<VehicleParams> ParseVehicle(const std::string& text, DeclarationError* error) {
-  static const std::vector<const char*> kKeys = {"volume", "cob", "added_mass", "linear_damping",
-                                                 "quadratic_damping"};
+  static const std::vector<const char*> kKeys = {"volume",         "cob",
+                                                 "added_mass",     "linear_damping",
+                                                 "quadratic_damping", "coriolis"};
   std::optional<KeyValues> pairs = SplitKeyValues(text, error);
   if (!pairs) return std::nullopt;
   VehicleParams p;
@@ -82,6 +83,11 @@ std::optional<VehicleParams> ParseVehicle(const std::string& text, DeclarationEr
                   : key == "linear_damping" ? p.linear_damping
                                             : p.quadratic_damping;
       if (ok) dst = Eigen::Map<const Vec6>(x.data());
+    } else if (key == "coriolis") {
+      p.coriolis = value == "1";
+      if (value != "0" && value != "1") {
+        ok = Fail(error, key, "key 'coriolis' = " + value + "; allowed: 0, 1");
+      }
     } else {
       ok = Fail(error, key, UnknownKey(key, kKeys));
     }

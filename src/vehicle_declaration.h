@@ -19,6 +19,7 @@ namespace mjtether {
 
 // Keys: volume [m^3] in [0, 1e4]; cob [m] 3 numbers in [-1000, 1000]; added_mass,
 // linear_damping, quadratic_damping: 6 numbers each in [0, 1e9]. All optional (default 0).
+// coriolis: 1 (default) or 0, the added mass's Coriolis/centripetal and Munk terms.
 std::optional<VehicleParams> ParseVehicle(const std::string& text, DeclarationError* error);
 
 // Keys: x, y, z = amplitude [m] in [0, 1e4], period [s] in (0, 1e6], phase [rad] in

@@ -423,3 +423,111 @@ TEST_F(VehicleTest, PrescribeMovesMocapBodiesAndTheTetherEndFollowsExactly) {
 
 }  // namespace
 }  // namespace mjtether
+
+namespace mjtether {
+namespace {
+
+// The Munk moment of the added mass, -(v_r x A_v v_r): moving along surge with A3 > A1, a
+// pitch angle theta gives heave velocity w ~ U theta and the moment (A3 - A1) U^2 theta, which
+// overturns the vehicle against its righting moment W z_b theta once
+// U > U_c = sqrt(W z_b / (A3 - A1)) = 0.50 m/s for the BlueROV2 of Wu (2018) (Fossen 2011,
+// eq. 6.43; the classic instability of a body moving along its axis of least added mass). A
+// body-fixed surge force F = D_l U + D_q U^2 holds the speed U; the vehicle starts pitched
+// 1 deg. At 0.7 U_c the pitch stays below 5 deg for 30 s; at 1.4 U_c it passes 30 deg; with
+// coriolis=0 (no C_A) 1.4 U_c stays below 5 deg too.
+TEST_F(VehicleTest, MunkMomentOverturnsPitchAboveTheCriticalSpeed) {
+  const double Uc = std::sqrt(kMass * kG * 0.02 / (14.57 - 5.5));  // [m/s]
+  struct Case {
+    double speed;
+    bool coriolis;
+    bool overturns;
+  };
+  for (const Case& c : {Case{0.7 * Uc, true, false}, Case{1.4 * Uc, true, true},
+                        Case{1.4 * Uc, false, false}}) {
+    Scene s;
+    if (!c.coriolis) s.quadratic = std::string(kQuadratic) + " coriolis=0";
+    const double theta0 = kPi / 180;
+    std::ostringstream quat;
+    quat.precision(17);
+    quat << std::cos(theta0 / 2) << " 0 " << std::sin(theta0 / 2) << " 0";
+    s.quat = quat.str();
+    mjModel* m = Load(VehicleXml(s));
+    mjData* d = Make(m);
+    const double F = 4.03 * c.speed + 18.18 * c.speed * c.speed;  // [N]
+    d->qvel[0] = c.speed;
+    double max_pitch = 0;
+    while (d->time < 30) {
+      const double* R = d->xmat + 9;  // body 1, row-major
+      for (int i = 0; i < 3; ++i) d->xfrc_applied[6 + i] = F * R[3 * i];  // along body x
+      mj_step(m, d);
+      // pitch: angle of the body x-axis out of the horizontal plane
+      max_pitch = std::max(max_pitch, std::abs(std::asin(d->xmat[9 + 6])));
+    }
+    if (c.overturns) {
+      EXPECT_GT(max_pitch, kPi / 6) << "U = " << c.speed;
+    } else {
+      EXPECT_LT(max_pitch, kPi / 36) << "U = " << c.speed << " coriolis " << c.coriolis;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace mjtether
+
+namespace mjtether {
+namespace {
+
+std::string ReadModel(const std::string& file) {
+  std::ifstream f(std::string(MJTETHER_MODELS_DIR) + "/" + file);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+// The surge-until-taut manoeuvre (models/manoeuvre_surge_snap.xml) against the same run
+// without the tether (its declaration renamed so that mjtether ignores it). Without the tether
+// the vehicle runs at its terminal speed (71 N of thrust: 1.8 m/s) for 11 s and ends farther
+// than L + 5 m from the surface point. With it, the vehicle can never be farther than the
+// stretched length L (1 + T_max/EA) plus the attachment's offset (0.25 m), and once the thrust
+// stops the stretched tether pulls it back (its surge velocity turns negative), which without
+// the tether never happens (the vehicle glides to rest: velocity >= 0 up to 1 mm/s).
+TEST_F(VehicleTest, SurgeUntilTautShowsTheTethersPull) {
+  const std::string xml = ReadModel("manoeuvre_surge_snap.xml");
+  ASSERT_FALSE(xml.empty());
+  std::string untethered = xml;
+  const size_t at = untethered.find("name=\"tether:umbilical\"");
+  ASSERT_NE(at, std::string::npos);
+  untethered.replace(at, 11, "name=\"none:");
+  struct Result {
+    double max_distance = 0, min_vx_after = 1e9, max_tension = 0;
+  };
+  auto run = [&](const std::string& text, const char* name) {
+    mjModel* m = Load(text, name);
+    mjData* d = Make(m);
+    const int surface = mj_name2id(m, mjOBJ_SITE, "surface");
+    const int rov = mj_name2id(m, mjOBJ_BODY, "rov");
+    Result r;
+    while (d->time < 30) {
+      Step(m, d);
+      EXPECT_FALSE(CheckDivergence(m, d));
+      const Vec3 p(d->xpos + 3 * rov), s(d->site_xpos + 3 * surface);
+      r.max_distance = std::max(r.max_distance, (p - s).norm());
+      if (d->time > 13) r.min_vx_after = std::min(r.min_vx_after, d->qvel[0]);
+      if (TetherCount(m) > 0) r.max_tension = std::max(r.max_tension, GetReactions(m, d, 0).tension_b);
+    }
+    return r;
+  };
+  const Result with = run(xml, "surge.xml"), without = run(untethered, "surge_free.xml");
+  const double L = 30, EA = 6e4;
+  std::printf("max distance %.2f m with the tether, %.2f m without; T_max %.1f N; min v_x "
+              "after the thrust %.3f / %.3f m/s\n",
+              with.max_distance, without.max_distance, with.max_tension, with.min_vx_after,
+              without.min_vx_after);
+  EXPECT_LT(with.max_distance, L * (1 + with.max_tension / EA) + 0.25);
+  EXPECT_GT(without.max_distance, L + 5);
+  EXPECT_LT(with.min_vx_after, 0);
+  EXPECT_GT(without.min_vx_after, -1e-3);
+}
+
+}  // namespace
+}  // namespace mjtether
