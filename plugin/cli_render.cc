@@ -3,11 +3,11 @@
 //
 //   mjtether render MODEL.xml --duration S --video out.mp4 [--fps 30] [--size 1280x720]
 //       [--camera follow|track:BODY|NAME] [--png-every S DIR] [--samples N]
-//       [--tension-max N] [--vehicle BODY] [--no-hud]
+//       [--tension-max N] [--distance M] [--speedup X] [--vehicle BODY] [--no-hud]
 //
 // Frame k shows the state at step round(k / (fps h)), h the model's timestep: frames are
 // scheduled by index, so they never drift from t = k/fps by more than h/2 however long the
-// video. The video has floor(duration * fps) frames and lasts `duration` seconds.
+// video. The video has floor(duration * fps) frames and lasts duration / speedup seconds.
 #include <unistd.h>
 
 #include <algorithm>
@@ -42,6 +42,8 @@ struct RenderCliOptions {
   std::vector<std::string> png_every;  // {interval, directory}
   int samples = 4;
   double tension_max = 0;
+  double distance = 0;
+  double speedup = 1;
   std::string vehicle;
   bool no_hud = false;
 };
@@ -128,6 +130,7 @@ int Render(const RenderCliOptions& opt) {
   ropt.samples = opt.samples;
   ropt.camera = opt.camera;
   ropt.vehicle = opt.vehicle;
+  ropt.distance = opt.distance;
   ropt.hud = !opt.no_hud;
 
   std::string error;
@@ -170,7 +173,7 @@ int Render(const RenderCliOptions& opt) {
   std::signal(SIGPIPE, SIG_IGN);  // a dead ffmpeg shows up as a failed write, not a signal
   const std::string size = std::to_string(W) + "x" + std::to_string(H);
   char rate[32];
-  std::snprintf(rate, sizeof(rate), "%.9g", opt.fps);
+  std::snprintf(rate, sizeof(rate), "%.9g", opt.fps * opt.speedup);  // playback frame rate
   mjtether::cli::ChildPipe ffmpeg;
   if (!opt.video.empty() &&
       !ffmpeg.Open({"ffmpeg",   "-hide_banner", "-loglevel", "error", "-y",    "-f",
@@ -282,6 +285,14 @@ std::function<int()> SetupRender(CLI::App* sub) {
                   "top of the tension colour scale [N]; default: the run's largest tension "
                   "rounded up to 1, 2, 3, 4, 5, 6 or 8 x 10^k")
       ->check(CLI::Range(0.0, 1e12));
+  sub->add_option("--distance", opt->distance,
+                  "camera distance for follow and track:BODY [m] (default 1.25 x the longest "
+                  "tether)")
+      ->check(CLI::Range(0.0, 1e6));
+  sub->add_option("--speedup", opt->speedup,
+                  "the video plays this many times faster than real time (its frame rate is "
+                  "fps x speedup; default 1)")
+      ->check(CLI::Range(0.01, 1000.0));
   sub->add_option("--vehicle", opt->vehicle, "body whose depth the HUD shows");
   sub->add_flag("--no-hud", opt->no_hud, "no text overlay or colour scale");
   return [opt]() { return Render(*opt); };

@@ -149,7 +149,9 @@ std::unique_ptr<Renderer> Renderer::Create(mjModel* m, const RenderOptions& opti
   // Follow distance: the longest tether should fit in the view; side-on to the current.
   double L = 0;
   for (int k = 0; k < TetherCount(m); ++k) L = std::max(L, GetTether(m, k)->params().length);
-  r->follow_distance_ = L > 0 ? 1.25 * L : std::max(3.0, 2.0 * m->stat.extent);
+  r->follow_distance_ = o.distance > 0 ? o.distance
+                        : L > 0        ? 1.25 * L
+                                       : std::max(3.0, 2.0 * m->stat.extent);
   if (TetherCount(m) > 0) {
     const Vec3& u = GetTether(m, 0)->env().water.current;
     if (std::hypot(u.x(), u.y()) > 0) {
@@ -352,8 +354,8 @@ void Renderer::DrawHud(const mjModel* m, const mjData* d) {
     const std::string name = TetherName(m, k);
     std::snprintf(buf, sizeof(buf), "\n%.1f N\n%.1f N", r.tension_a, r.tension_b);
     values += buf;
-    titles += "\n" + name + ": T at " + BodyName(m, EndBody(m, k, 0)) + "\n" + name + ": T at " +
-              BodyName(m, EndBody(m, k, 1));
+    titles += "\n" + name + ": T at end A (" + BodyName(m, EndBody(m, k, 0)) + ")\n" + name +
+              ": T at end B (" + BodyName(m, EndBody(m, k, 1)) + ")";
   }
   if (vehicle_ >= 0) {
     std::snprintf(buf, sizeof(buf), "\n%.2f m", -d->xpos[3 * vehicle_ + 2]);

@@ -31,10 +31,12 @@ struct RenderOptions {
   int width = 1280;  // [pixel] even, in [16, 4096] (H.264 with yuv420p needs even sizes)
   int height = 720;  // [pixel] even, in [16, 4096]
   int samples = 4;   // multisampling (MSAA) samples, 0 to 16; 0 halves the software cost
-  // "follow" (default): a free camera looking at the point midway between the vehicle and its
-  // tether's centre, from the side of the current, at a fixed distance; "track:BODY":
-  // MuJoCo's tracking camera on BODY; otherwise the name of a <camera> in the model.
+  // "follow" (default): a free camera looking at the centre of the box bounding the tethers
+  // and the vehicle, from the side of the current (across it), 12 degrees down, at a fixed
+  // distance; "track:BODY": MuJoCo's tracking camera on BODY, same direction and distance;
+  // otherwise the name of a <camera> in the model.
   std::string camera = "follow";
+  double distance = 0;       // [m] of the follow and track cameras; <= 0: 1.25 x the longest tether
   double tension_max = 0;    // [N] top of the colour scale; <= 0: 1 N
   std::string vehicle;       // body whose depth the HUD shows; empty: found (see Vehicle)
   bool hud = true;           // draw the HUD and the colour scale

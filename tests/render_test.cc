@@ -326,18 +326,19 @@ TEST_F(RenderCli, VideoHasTheFrameCountAndSizeAsked) {
   }
   const std::string video = (dir_ / "out.mp4").string();
   int status = 0;
-  Shell(cli_ + " render " + model_ + " --duration 1 --fps 10 --size 160x120 --samples 0" +
-            " --video " + video + " --png-every 0.5 " + (dir_ / "stills").string() + " 2>&1",
+  Shell(cli_ + " render " + model_ +
+            " --duration 1 --fps 10 --speedup 2 --size 160x120 --samples 0" + " --video " + video +
+            " --png-every 0.5 " + (dir_ / "stills").string() + " 2>&1",
         &status);
   ASSERT_EQ(status, 0);
-  // 1 s at 10 fps: frames at t = 0, 0.1, ..., 0.9.
+  // 1 s at 10 fps: frames at t = 0, 0.1, ..., 0.9, played at 10 x 2 = 20 frames per second.
   const std::string probe = Shell(
       "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
-      "stream=width,height,nb_read_frames,codec_name,pix_fmt -of csv=p=0 " +
+      "stream=width,height,nb_read_frames,codec_name,pix_fmt,r_frame_rate -of csv=p=0 " +
           video,
       &status);
   ASSERT_EQ(status, 0);
-  EXPECT_EQ(probe, "h264,160,120,yuv420p,10\n");
+  EXPECT_EQ(probe, "h264,160,120,yuv420p,20/1,10\n");
   // Stills at t = 0 and 0.5 s, the video's size.
   for (const char* name : {"t_00000.000.png", "t_00000.500.png"}) {
     const std::array<int, 2> size = PngSize((dir_ / "stills" / name).string());
