@@ -249,7 +249,7 @@ std::optional<TetherDeclaration> ParseTether(const std::string& text, const Envi
   static const char* const kKeys[] = {
       "ends",    "length", "segments",   "diameter", "mass_per_length", "EA",
       "EI",      "damping", "Cdn",       "Cdt",      "Can",             "integrator",
-      "clamp",   "effects", "substeps",  "max_step", "max_strain"};
+      "clamp",   "effects", "substeps",  "max_step", "max_strain", "bending"};
   static const char* const kRequired[] = {"ends",     "length",          "segments",
                                           "diameter", "mass_per_length", "EA"};
   std::optional<KeyValues> pairs = SplitKeyValues(text, error);
@@ -306,8 +306,19 @@ std::optional<TetherDeclaration> ParseTether(const std::string& text, const Envi
         p.integrator = Integrator::kExplicit;
       } else if (value == "implicit") {
         p.integrator = Integrator::kImplicit;
+      } else if (value == "implicit2") {
+        p.integrator = Integrator::kImplicit2;
       } else {
-        ok = Fail(error, key, "key 'integrator' = " + value + "; allowed: explicit, implicit");
+        ok = Fail(error, key,
+                  "key 'integrator' = " + value + "; allowed: explicit, implicit, implicit2");
+      }
+    } else if (key == "bending") {
+      if (value == "galerkin") {
+        p.bending = Bending::kGalerkin;
+      } else if (value == "der") {
+        p.bending = Bending::kDER;
+      } else {
+        ok = Fail(error, key, "key 'bending' = " + value + "; allowed: galerkin, der");
       }
     } else if (key == "clamp") {
       clamp = value;

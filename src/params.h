@@ -34,9 +34,18 @@ inline constexpr const char* kEffectNames[] = {"axial",    "damping",    "bendin
                                                "current",  "seabed",     "clamp"};
 inline constexpr int kNumEffects = 10;
 
+// How nodal curvature is measured from the turning angle theta between two segments (both
+// give the same small-angle stiffness EI/w; they differ at large angles per node).
+enum class Bending {
+  kGalerkin,  // M = EI sin(theta)/w, potential EI/w (1 - cos theta) (Buckham & Nahon 1999)
+  kDER,       // discrete elastic rod (Bergou et al. 2008): kappa = 2 tan(theta/2)/w, potential
+              // 2 EI/w tan^2(theta/2), M = its derivative 2 EI/w tan(theta/2)/cos^2(theta/2)
+};
+
 enum class Integrator {
   kExplicit,  // symplectic Euler, substeps from the stability limit
   kImplicit,  // linearised backward Euler, banded solve
+  kImplicit2,  // two-stage L-stable SDIRK (second order), each stage a backward-Euler solve
 };
 
 // The water a tether is in (declared by <text name="water">). Absent: a dry scene.
@@ -64,6 +73,7 @@ struct TetherParams {
   double Cdt = 0;              // [-] tangential drag coefficient, reference area pi*d per length
   double Can = 0;              // [-] normal added-mass coefficient, reference pi*d^2/4 per length
   Integrator integrator = Integrator::kImplicit;
+  Bending bending = Bending::kGalerkin;  // curvature formulation (bending=galerkin|der)
   bool free_end = false;       // end B is not attached (dangling)
   bool clamp_a = false;        // end A tangent held along its site's x-axis
   bool clamp_b = false;        // end B tangent held along its site's x-axis

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "band_cholesky.h"
+#include "block_band.h"
 
 namespace mjtether {
 namespace {
@@ -31,13 +31,15 @@ struct Work {
   double* x2;    // 3 x n   state copy for Reactions
   double* v2;    // 3 x n
   double* rhs;   // 3 x n   implicit right-hand side / velocity change
-  double* band;  // (3 x n) x 9  implicit band matrix
+  double* band;  // 27 x n  implicit block-band matrix (3x3 blocks, block_band.h)
   double* xs;    // 3 x n   state saved before an implicit step, to retry it in halves
   double* vs;    // 3 x n
+  double* x0;    // 3 x n   state at the start of a two-stage step (implicit2)
+  double* v0;    // 3 x n
   static int Size(int N) {
     const int n = N + 1;
     return 3 * n + 3 * N + N + N + 3 * n + 3 * n + 3 * n + 3 * n + 3 * n +
-           BandMatrix::Size(3 * n, 8) + 6 * n;
+           BlockBand::Size(n) + 12 * n;
   }
   Work(double* w, int N) {
     const int n = N + 1;
@@ -51,8 +53,10 @@ struct Work {
     v2 = x2 + 3 * n;
     rhs = v2 + 3 * n;
     band = rhs + 3 * n;
-    xs = band + BandMatrix::Size(3 * n, 8);
+    xs = band + BlockBand::Size(n);
     vs = xs + 3 * n;
+    x0 = vs + 3 * n;
+    v0 = x0 + 3 * n;
   }
 };
 
@@ -159,16 +163,32 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
     const double zeta = rate / (2 * w);
     c.explicit_dt_ = kExplicitSafety * 2 / w * (std::sqrt(1 + zeta * zeta) - zeta);
   }
+  // The 3-node window for the end reactions: rest length L0 per segment, so its end nodes
+  // carry the same lumped length, mass, weight and curvature weights as the tether's.
+  if (c.N_ >= 3) {
+    TetherParams wp = params;
+    wp.segments = 2;
+    wp.length = 2 * c.L0_;
+    std::optional<Tether> window = Create(wp, env, error);
+    if (!window) return std::nullopt;
+    c.window_ = std::make_shared<const Tether>(std::move(*window));
+  }
   return tether;
 }
 
-int Tether::WorkspaceSize() const { return Work::Size(N_); }
+// The window's inputs (x, v 3 x 3 each), outputs (f 3 x 3, T 2) and its own scratch follow
+// the tether's scratch.
+constexpr int kWindowIo = 9 + 9 + 9 + 2;
+
+int Tether::WorkspaceSize() const {
+  return Work::Size(N_) + (window_ ? kWindowIo + window_->WorkspaceSize() : 0);
+}
 
 int Tether::SubstepsFor(double dt) const {
   if (!(dt > 0)) return 0;
   if (p_.substeps > 0) return p_.substeps;
   if (p_.max_step > 0) return static_cast<int>(std::ceil(dt / p_.max_step - 1e-9));
-  if (p_.integrator == Integrator::kImplicit) return 1;
+  if (p_.integrator != Integrator::kExplicit) return 1;
   const double n = std::ceil(dt / explicit_dt_ - 1e-9);
   return static_cast<int>(std::min(std::max(n, 1.0), 1e9));
 }
@@ -277,16 +297,28 @@ void Tether::AddAxial(ConstNodes x, ConstNodes v, ConstNodes t, const double* l,
 // (Buckham & Nahon 1999: curvature from the jump of the piecewise-constant tangent, weighted
 // residual with linear shape functions). A clamped end uses its site axis as the tangent
 // before node 0 (or after node N) with w = L0/2; a pinned or free end has M = 0.
+//
+// With bending=der the curvature is that of the discrete elastic rod (Bergou et al., "Discrete
+// elastic rods", SIGGRAPH 2008), |kappa| = 2 tan(theta/2)/w, and M is the derivative of its
+// energy 2 EI/w tan^2(theta/2) with respect to theta: M = 4 EI/w (ta x tb)/(1 + ta.tb)^2.
+// Both equal EI theta/w to first order. (1 + ta.tb) is kept above 1e-2 (a node folded back
+// by more than ~170 degrees) so that the moment stays finite.
 void Tether::BendingMoments(ConstNodes t, const Ends& ends, Nodes M) const {
+  const bool der = p_.bending == Bending::kDER;
+  auto moment = [&](const Vec3& ta, const Vec3& tb, double w) -> Vec3 {
+    if (!der) return p_.EI / w * ta.cross(tb);
+    const double c = std::max(1 + ta.dot(tb), 1e-2);
+    return 4 * p_.EI / (w * c * c) * ta.cross(tb);
+  };
   M.setZero();
   for (int i = 1; i < N_; ++i) {
-    M.col(i) = p_.EI / L0_ * t.col(i - 1).cross(t.col(i));
+    M.col(i) = moment(t.col(i - 1), t.col(i), L0_);
   }
   if (Has(kClamp) && p_.clamp_a) {
-    M.col(0) = p_.EI / (0.5 * L0_) * ends.a.axis.cross(Vec3(t.col(0)));
+    M.col(0) = moment(ends.a.axis, t.col(0), 0.5 * L0_);
   }
   if (Has(kClamp) && p_.clamp_b) {
-    M.col(N_) = p_.EI / (0.5 * L0_) * Vec3(t.col(N_ - 1)).cross(ends.b.axis);
+    M.col(N_) = moment(t.col(N_ - 1), ends.b.axis, 0.5 * L0_);
   }
 }
 
@@ -380,6 +412,39 @@ EndReactions Tether::Reactions(const double* xp, const double* vp, const Ends& e
                                double* work) const {
   Work w(work, N_);
   const int n = N_ + 1;
+  if (window_) {
+    // Each end from its 3-node window: the force on an end node involves only its segment,
+    // the curvature at its neighbour (the segment after) and its own drag, weight and seabed.
+    const Tether& wt = *window_;
+    double* io = work + Work::Size(N_);
+    double *wx = io, *wv = io + 9, *wf = io + 18, *wT = io + 27;
+    double* scratch = io + kWindowIo;
+    ConstNodes x(xp, 3, n), v(vp, 3, n);
+    Nodes X(wx, 3, 3), V(wv, 3, 3);
+    ConstNodes F(wf, 3, 3), M(Work(scratch, 2).M, 3, 3);
+    EndReactions r;
+    X.col(0) = ends.a.pos;
+    V.col(0) = ends.a.vel;
+    X.rightCols(2) = x.middleCols(1, 2);
+    V.rightCols(2) = v.middleCols(1, 2);
+    wt.ComputeForces(wx, wv, ends, wf, wT, scratch);
+    r.force_a = F.col(0);
+    r.tension_a = r.force_a.norm();
+    if (Has(kClamp) && p_.clamp_a) r.torque_a = M.col(0);
+    X.leftCols(2) = x.middleCols(N_ - 2, 2);
+    V.leftCols(2) = v.middleCols(N_ - 2, 2);
+    X.col(2) = p_.free_end ? Vec3(x.col(N_)) : ends.b.pos;
+    V.col(2) = p_.free_end ? Vec3(v.col(N_)) : ends.b.vel;
+    wt.ComputeForces(wx, wv, ends, wf, wT, scratch);
+    if (p_.free_end) {
+      r.tension_b = wT[1];
+    } else {
+      r.force_b = F.col(2);
+      r.tension_b = r.force_b.norm();
+      if (Has(kClamp) && p_.clamp_b) r.torque_b = -M.col(2);
+    }
+    return r;
+  }
   Nodes x(w.x2, 3, n), v(w.v2, 3, n);
   x = ConstNodes(xp, 3, n);
   v = ConstNodes(vp, 3, n);
@@ -446,14 +511,16 @@ double Tether::PotentialEnergy(const double* xp, const Ends& ends) const {
     Vec3 t = l > 0 ? Vec3(dx / l) : Vec3::Zero();
     // Bending: the potential of the forces of AddBending is EI/w (1 - cos theta) per node
     // (theta the turning angle, w the curvature weight), since M = EI sin(theta)/w.
+    // With bending=der: 2 EI/w tan^2(theta/2) = 2 EI/w (1 - cos)/(1 + cos).
     if (Has(kBending)) {
-      if (j > 0) E += p_.EI / L0_ * (1 - t_prev.dot(t));
-      if (j == 0 && Has(kClamp) && p_.clamp_a) {
-        E += p_.EI / (0.5 * L0_) * (1 - ends.a.axis.dot(t));
-      }
-      if (j == N_ - 1 && Has(kClamp) && p_.clamp_b) {
-        E += p_.EI / (0.5 * L0_) * (1 - t.dot(ends.b.axis));
-      }
+      auto energy = [&](const Vec3& ta, const Vec3& tb, double w) {
+        const double c = ta.dot(tb);
+        if (p_.bending != Bending::kDER) return p_.EI / w * (1 - c);
+        return 2 * p_.EI / w * (1 - c) / std::max(1 + c, 1e-2);
+      };
+      if (j > 0) E += energy(t_prev, t, L0_);
+      if (j == 0 && Has(kClamp) && p_.clamp_a) E += energy(ends.a.axis, t, 0.5 * L0_);
+      if (j == N_ - 1 && Has(kClamp) && p_.clamp_b) E += energy(t, ends.b.axis, 0.5 * L0_);
     }
     t_prev = t;
   }
@@ -507,7 +574,8 @@ void Tether::ExplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
 // bending stiffness EI/w g g^T (g the second-difference stencil of the curvature), and the
 // seabed stiffness; D the axial damping, the drag and seabed damping, and the secant of the
 // friction. Every block is symmetric and K <= 0, D <= 0, so the matrix is SPD and banded
-// (3x3 blocks, two off-diagonals with bending, one without): a band Cholesky solves it.
+// (3x3 blocks, two off-diagonals with bending, one without): a block Cholesky with fixed-size
+// 3x3 blocks (block_band.h) solves it, assembled directly block by block.
 bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
                           double* work) const {
   (void)now;
@@ -532,57 +600,60 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
     return true;
   }
   ConstNodes f(w.f, 3, n), t(w.t, 3, N_), q(w.q, 3, n);
-  const int band_p = Has(kBending) ? 8 : 5;
-  BandMatrix A(w.band, 3 * nu, band_p);
+  BlockBand A(w.band, nu, Has(kBending) ? 2 : 1);
   Nodes rhs(w.rhs, 3, nu);
   const Mat3 I = Mat3::Identity();
-  const Mat3 Z = Mat3::Zero();
-
-  // Adds df_i/dx_j = K, df_i/dv_j = D of the current iterate to A (lower triangle only).
-  auto couple = [&](int i, int j, const Mat3& K, const Mat3& D) {
-    if (!Dynamic(i) || !Dynamic(j) || j > i) return;
-    const Mat3 B = -h * D - h * h * K;
-    const int r0 = 3 * (i - 1), c0 = 3 * (j - 1);
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) {
-        if (i == j && c > r) continue;
-        A.Add(r0 + r, c0 + c, B(r, c));
-      }
-    }
-  };
+  const double h2 = h * h;
 
   bool settled = false;
   for (int iter = 0; iter < kMaxNewton && !settled; ++iter) {
     ComputeForces(w.x2, w.v2, next, w.f, w.T, work);
     A.SetZero();
     // Node mass with normal added mass; residual -G = h f - M (v+ - v).
+    const bool added = Has(kAddedMass);
     for (int i = 1; i <= nu; ++i) {
-      Mat3 Mi = mass_(i) * I;
-      if (Has(kAddedMass)) Mi += added_(i) * (I - q.col(i) * q.col(i).transpose());
-      rhs.col(i - 1) = h * f.col(i) - Mi * (vk.col(i) - v.col(i));
-      for (int r = 0; r < 3; ++r) {
-        for (int c = 0; c <= r; ++c) A.Add(3 * (i - 1) + r, 3 * (i - 1) + c, Mi(r, c));
+      BlockBand::Block d = A.D(i - 1);
+      const Vec3 dv = vk.col(i) - v.col(i);
+      if (added) {
+        const Vec3 qi = q.col(i);
+        d = mass_(i) * I + added_(i) * (I - qi * qi.transpose());
+        rhs.col(i - 1) = h * f.col(i) - d * dv;
+      } else {
+        d.diagonal().setConstant(mass_(i));
+        rhs.col(i - 1) = h * f.col(i) - mass_(i) * dv;
       }
     }
-    // Axial stiffness and damping of taut segments.
+    // Axial stiffness and damping of taut segments: B = h D + h^2 K with
+    // K = EA/L0 t t^T + T/l (I - t t^T), D = damping/L0 t t^T; +B on both diagonal blocks,
+    // -B on the coupling block.
     if (Has(kAxial)) {
+      const double ka = p_.EA / L0_;
+      const double ca = Has(kDamping) ? p_.damping / L0_ : 0;
       for (int j = 0; j < N_; ++j) {
-        if (!(w.l[j] > L0_) || w.l[j] == 0) continue;
-        const Mat3 tt = t.col(j) * t.col(j).transpose();
-        const Mat3 K = p_.EA / L0_ * tt + w.T[j] / w.l[j] * (I - tt);
-        const Mat3 D = Has(kDamping) && w.T[j] > 0 ? Mat3(p_.damping / L0_ * tt) : Z;
-        couple(j, j, -K, -D);
-        couple(j + 1, j, K, D);
-        couple(j + 1, j + 1, -K, -D);
+        if (!(w.l[j] > L0_)) continue;
+        const Vec3 tj = t.col(j);
+        const double geo = h2 * w.T[j] / w.l[j];
+        const double along = h2 * ka + (w.T[j] > 0 ? h * ca : 0) - geo;
+        const Mat3 B = along * tj * tj.transpose() + geo * I;
+        const bool d0 = Dynamic(j), d1 = Dynamic(j + 1);
+        if (d0) A.D(j - 1) += B;
+        if (d1) A.D(j) += B;
+        if (d0 && d1) A.L1(j) -= B;
       }
     }
-    // Bending: K = -EI/w g g^T I on the stencil of each curvature.
+    // Bending: K = -EI/w g g^T I on the stencil of each curvature; B = h^2 EI/(w L0^2) g g^T I.
     if (Has(kBending)) {
       auto stencil = [&](const int* nodes, const double* g, int count, double weight) {
-        const double k = p_.EI / (weight * L0_ * L0_);
+        const double k = h2 * p_.EI / (weight * L0_ * L0_);
         for (int a = 0; a < count; ++a) {
+          if (!Dynamic(nodes[a])) continue;
+          const int ua = nodes[a] - 1;
           for (int b = 0; b <= a; ++b) {
-            couple(nodes[a], nodes[b], -k * g[a] * g[b] * I, Z);
+            if (!Dynamic(nodes[b])) continue;
+            const double s = k * g[a] * g[b];
+            const int gap = a - b;
+            BlockBand::Block blk = gap == 0 ? A.D(ua) : gap == 1 ? A.L1(ua) : A.L2(ua);
+            blk.diagonal().array() += s;
           }
         }
       };
@@ -600,18 +671,21 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         stencil(nodes, g2, 2, 0.5 * L0_);
       }
     }
-    // Drag: d(|vn| vn)/dv_r = |vn| P + vn vn^T/|vn|, d(|vt| vt)/dv_r = 2 |vt| q q^T.
+    // Drag: d(|vn| vn)/dv_r = |vn| P + vn vn^T/|vn|, d(|vt| vt)/dv_r = 2 |vt| q q^T; B = -h D.
     if (Has(kDrag)) {
       const Vec3 u = Has(kCurrent) ? env_.water.current : Vec3::Zero();
       for (int i = 1; i <= nu; ++i) {
         const double li = 0.5 * (w.l[i - 1] + (i < N_ ? w.l[i] : 0));
         const Vec3 qi = q.col(i);
         const Vec3 vr = u - vk.col(i);
-        const Vec3 vt = vr.dot(qi) * qi, vn = vr - vt;
-        const Mat3 P = I - qi * qi.transpose();
-        Mat3 J = kt_ * 2 * vt.norm() * qi * qi.transpose();
-        if (vn.norm() > 0) J += kn_ * (vn.norm() * P + vn * vn.transpose() / vn.norm());
-        couple(i, i, Z, -li * J);
+        const double vq = vr.dot(qi);
+        const Vec3 vn = vr - vq * qi;
+        const double vnn = vn.norm();
+        const double ht = h * li;
+        Mat3 J = (ht * (kt_ * 2 * std::abs(vq) - kn_ * vnn)) * qi * qi.transpose();
+        J.diagonal().array() += ht * kn_ * vnn;
+        if (vnn > 0) J += (ht * kn_ / vnn) * vn * vn.transpose();
+        A.D(i - 1) += J;
       }
     }
     // Seabed: normal stiffness and damping, friction secant.
@@ -620,16 +694,15 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
       for (int i = 1; i <= nu; ++i) {
         const double pen = wt.seabed - xk(2, i);
         if (pen <= 0) continue;
-        Mat3 K = Z, D = Z;
-        K(2, 2) = -seabed_k_ * share_(i);
-        D(2, 2) = -seabed_c_ * share_(i);
+        BlockBand::Block d = A.D(i - 1);
+        d(2, 2) += h2 * seabed_k_ * share_(i) + h * seabed_c_ * share_(i);
         const double N = std::max(0.0, share_(i) * (seabed_k_ * pen - seabed_c_ * vk(2, i)));
         const double mu = std::max(wt.seabed_friction, wt.seabed_friction_axial);
         const double vh = std::hypot(vk(0, i), vk(1, i));
         const double eps = wt.seabed_friction_speed;
         const double secant = vh > 1e-9 * eps ? mu * N * std::tanh(vh / eps) / vh : mu * N / eps;
-        D(0, 0) = D(1, 1) = -secant;
-        couple(i, i, K, D);
+        d(0, 0) += h * secant;
+        d(1, 1) += h * secant;
       }
     }
     // Solve; a failed factorisation leaves NaN behind for the divergence check to report.
@@ -643,8 +716,9 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
     // Did a segment change between slack and taut? Then the linearisation was wrong there.
     place();
     bool changed = false;
+    const double L0sq = L0_ * L0_;
     for (int j = 0; j < N_ && !changed; ++j) {
-      changed = ((xk.col(j + 1) - xk.col(j)).norm() > L0_) != (w.l[j] > L0_);
+      changed = ((xk.col(j + 1) - xk.col(j)).squaredNorm() > L0sq) != (w.l[j] > L0_);
     }
     settled = !changed;
   }
@@ -672,6 +746,35 @@ void Tether::ImplicitStepAdaptive(Nodes x, Nodes v, const Ends& now, const Ends&
   ImplicitStepAdaptive(x, v, mid, next, h / 2, depth + 1, work);
 }
 
+// Two-stage, stiffly accurate, L-stable SDIRK of order 2 (Alexander, SIAM J. Numer. Anal. 14,
+// 1977), gamma = 1 - 1/sqrt(2), on y = (x, v), y' = F(y) = (v, a(x, v)):
+//   Y1 = y + gamma h F(Y1),   y+ = Y2 = y + (1 - gamma) h F(Y1) + gamma h F(Y2).
+// Both stages are backward-Euler steps of size gamma h: the first from y (ends at t + gamma h),
+// the second from y~ = y + (1 - gamma)/gamma (Y1 - y), i.e. x~ = x + (1 - gamma) h V1,
+// v~ = v + (1 - gamma)/gamma (V1 - v) (ends at t + h). Backward Euler damps a mode of frequency
+// w by about w h/2 per radian, which at the vehicle's step is as much as the tether's own
+// damping of its first axial modes; this scheme's error is O(h^2) and its damping O((w h)^3),
+// and it still removes the unresolved axial modes (L-stable).
+void Tether::Sdirk2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
+                        double* work) const {
+  constexpr double kGamma = 0.29289321881345247560;  // 1 - 1/sqrt(2)
+  Work w(work, N_);
+  const int n = N_ + 1;
+  Nodes x0(w.x0, 3, n), v0(w.v0, 3, n);
+  x0 = x;
+  v0 = v;
+  const Ends mid = Interpolate(now, next, h, kGamma);
+  ImplicitStepAdaptive(x, v, now, mid, kGamma * h, 0, work);
+  // x, v hold Y1; form y~ on the dynamic nodes (the ends are set by the next stage).
+  const double a = (1 - kGamma) / kGamma;
+  for (int i = 0; i < n; ++i) {
+    if (!Dynamic(i)) continue;
+    x.col(i) = x0.col(i) + (1 - kGamma) * h * v.col(i);
+    v.col(i) = v0.col(i) + a * (v.col(i) - v0.col(i));
+  }
+  ImplicitStepAdaptive(x, v, mid, next, kGamma * h, 0, work);
+}
+
 StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends& to, double dt,
                            double* work) const {
   const int n = N_ + 1;
@@ -691,6 +794,8 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
     const Ends next = k + 1 == steps ? to : Interpolate(from, to, dt, double(k + 1) / steps);
     if (p_.integrator == Integrator::kExplicit) {
       ExplicitStep(x, v, now, next, h, work);
+    } else if (p_.integrator == Integrator::kImplicit2) {
+      Sdirk2Step(x, v, now, next, h, work);
     } else {
       ImplicitStepAdaptive(x, v, now, next, h, 0, work);
     }

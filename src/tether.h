@@ -17,6 +17,7 @@
 #ifndef MJTETHER_SRC_TETHER_H_
 #define MJTETHER_SRC_TETHER_H_
 
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -139,6 +140,8 @@ class Tether {
                     double* work) const;
   void ImplicitStepAdaptive(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
                             int depth, double* work) const;
+  void Sdirk2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
+                  double* work) const;
 
   bool Has(unsigned effect) const { return (p_.effects & effect) != 0; }
   bool Dynamic(int i) const { return i > 0 && (i < N_ || p_.free_end); }
@@ -155,6 +158,10 @@ class Tether {
   Eigen::VectorXd added_;       // [kg] (n) normal added mass Can rho A l_i
   Eigen::VectorXd share_;       // [m] (n) rest length lumped at each node
   Eigen::Matrix3Xd weight_;     // [N] (3 x n) weight minus buoyancy per node
+  // The same tether cut to its first two segments (N >= 3): the end reactions depend only on
+  // the end node's two neighbours, so Reactions evaluates this 3-node window at each end
+  // instead of the whole tether (same operations in the same order, so the same bits).
+  std::shared_ptr<const Tether> window_;
 };
 
 }  // namespace mjtether

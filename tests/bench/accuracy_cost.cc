@@ -1,0 +1,621 @@
+// What accuracy costs in time: runs reference scenes across integrators, segment counts and
+// time steps, measures the error of end tension and node positions against a converged
+// reference and the wall time per simulated second, and writes a CSV and a markdown table.
+//
+//   accuracy_cost [--quick] [--scenes line,catenary,...] [--out DIR]
+//
+// Scenes (see Scenes() below):
+//   line      the fixed comparison scene: 100 m line, anchor (0,0,-150), fairlead from
+//             (80,0,-100) moving x = 80 + 2 sin(2 pi t/10), 60 s; error = RMS fairlead tension.
+//             Run by the engine alone, through MuJoCo (fairlead on a mocap body), and as a
+//             MuJoCo <composite type="rope"> chain.
+//   catenary  static elastic catenary settling from the inextensible shape; reference: Irvine's
+//             closed form (tests/catenary_reference.h).
+//   swing     a dry chain released horizontal from a fixed end (pendulum of a free tether).
+//   snap      a slack line jerked taut: end B moves 0.9 L -> 1.005 L in 0.5 s.
+//   slack     slack ROV tether with bending and a current, end B circling.
+//
+// Reference: for each scene, the finest segment count (Nref), integrated with the explicit
+// scheme at a quarter and an eighth of its stable step and extrapolated (Richardson, order 1);
+// with the same procedure at each N, a reference of the same N separates the time error from
+// the space error. Error columns: `err_T` RMS over the samples of the end tension against the
+// finest reference, `err_T_time` against the same-N reference, `err_x` RMS over samples of the
+// largest node distance to the reference's node at the same arc length.
+#include <mujoco/mujoco.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <functional>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "../catenary_reference.h"
+#include "declaration.h"
+#include "mjtether.h"
+#include "tether.h"
+
+namespace mjtether {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+using Clock = std::chrono::steady_clock;
+
+// ------------------------------------------------------------------------------------------
+// Scenes
+
+struct Scene {
+  std::string name;
+  std::string declaration;  // tether keys without ends, segments, integrator
+  std::string water;        // water keys, empty: dry
+  Vec3 gravity = Vec3(0, 0, -9.81);
+  std::function<EndState(double)> a, b;  // end motions; b empty: free end
+  double duration = 0;                   // [s]
+  double sample = 0.1;                   // [s] sampling interval of the error
+  std::vector<int> segments;             // N of the sweep
+  int reference_segments = 0;            // finest N (reference)
+  bool static_reference = false;         // error of the final tension against the closed form
+  double static_tension = 0;             // [N] closed-form end tension at B
+};
+
+EndState Fixed(Vec3 p) {
+  EndState e;
+  e.pos = p;
+  return e;
+}
+
+Scene LineScene() {
+  Scene s;
+  s.name = "line";
+  s.declaration =
+      "length=100 diameter=0.025 mass_per_length=1 EA=1e6 damping=1000 Cdn=1.2 Can=1 "
+      "Cdt=0.008";
+  s.water = "density=1025";
+  s.a = [](double) { return Fixed(Vec3(0, 0, -150)); };
+  s.b = [](double t) {
+    EndState e;
+    const double w = 2 * kPi / 10;
+    e.pos = Vec3(80 + 2 * std::sin(w * t), 0, -100);
+    e.vel = Vec3(2 * w * std::cos(w * t), 0, 0);
+    return e;
+  };
+  s.duration = 60;
+  s.segments = {10, 20, 40, 80};
+  s.reference_segments = 160;
+  return s;
+}
+
+Scene CatenaryScene() {
+  Scene s;
+  s.name = "catenary";
+  // Heavily damped so that it settles; the error is that of the settled end tension.
+  s.declaration = "length=100 diameter=0.02 mass_per_length=1 EA=1e5 damping=2000 Cdn=1.2";
+  s.water = "density=1025";
+  s.a = [](double) { return Fixed(Vec3(0, 0, 0)); };
+  s.b = [](double) { return Fixed(Vec3(80, 0, 20)); };
+  s.duration = 40;
+  s.sample = 40;
+  s.segments = {10, 20, 40, 80};
+  s.reference_segments = 80;
+  s.static_reference = true;
+  const double w = (1.0 - 1025 * kPi * 0.02 * 0.02 / 4) * 9.81;  // [N/m] wet weight
+  s.static_tension = testing::SolveCatenary(80, 20, 100, w, 1e5).tension_b();
+  return s;
+}
+
+Scene SwingScene() {
+  Scene s;
+  s.name = "swing";
+  s.declaration = "length=10 diameter=0.01 mass_per_length=0.5 EA=1e5 damping=5";
+  s.gravity = Vec3(0, 0, -9.81);
+  s.a = [](double) {
+    EndState e = Fixed(Vec3(0, 0, 0));
+    e.axis = Vec3(1, 0, 0);
+    return e;
+  };
+  s.duration = 5;
+  s.sample = 0.02;
+  s.segments = {10, 20, 40, 80};
+  s.reference_segments = 160;
+  return s;
+}
+
+Scene SnapScene() {
+  Scene s;
+  s.name = "snap";
+  s.declaration =
+      "length=20 diameter=0.02 mass_per_length=0.35 EA=2e5 damping=50 Cdn=1.2 Cdt=0.01 Can=1";
+  s.water = "density=1025";
+  s.gravity = Vec3(0, 0, -9.81);
+  s.a = [](double) { return Fixed(Vec3(0, 0, 0)); };
+  // End B moves along x from 0.9 L to 1.005 L in 0.5 s (smooth cubic ramp), then holds.
+  s.b = [](double t) {
+    const double T = 0.5, d0 = 18, d1 = 20.1;
+    const double u = std::min(t / T, 1.0);
+    EndState e;
+    e.pos = Vec3(d0 + (d1 - d0) * (3 * u * u - 2 * u * u * u), 0, 0);
+    e.vel = Vec3(t < T ? (d1 - d0) * (6 * u - 6 * u * u) / T : 0, 0, 0);
+    return e;
+  };
+  s.duration = 3;
+  s.sample = 0.01;
+  s.segments = {10, 20, 40, 80};
+  s.reference_segments = 160;
+  return s;
+}
+
+Scene SlackScene() {
+  Scene s;
+  s.name = "slack";
+  s.declaration =
+      "length=40 diameter=0.02 mass_per_length=0.35 EA=2e5 EI=0.5 damping=50 Cdn=1.2 Cdt=0.01 "
+      "Can=1";
+  s.water = "density=1025 current=0.3,0,0";
+  s.a = [](double) { return Fixed(Vec3(0, 0, 0)); };
+  // End B circles (radius 3 m, period 20 s) around (20, 0, -15).
+  s.b = [](double t) {
+    const double w = 2 * kPi / 20;
+    EndState e;
+    e.pos = Vec3(20 + 3 * std::cos(w * t), 3 * std::sin(w * t), -15);
+    e.vel = Vec3(-3 * w * std::sin(w * t), 3 * w * std::cos(w * t), 0);
+    return e;
+  };
+  s.duration = 20;
+  s.sample = 0.1;
+  s.segments = {10, 20, 40, 80};
+  s.reference_segments = 160;
+  return s;
+}
+
+// ------------------------------------------------------------------------------------------
+// One run through the engine alone.
+
+struct Run {
+  std::string scene, path, integrator;  // path: engine, mujoco, composite
+  int segments = 0;
+  double step = 0;   // [s] the integrator's step (tether step; the MuJoCo step for composite)
+  double outer = 0;  // [s] the coupling step (Advance / mj_step)
+  double wall = 0;   // [s] wall time of the whole run
+  bool ok = true;
+  std::vector<double> T;             // end tension at each sample [N]
+  std::vector<std::vector<Vec3>> x;  // nodes at each sample
+  double err_T = NAN, err_T_time = NAN, err_x = NAN;
+  double cost() const { return wall; }
+};
+
+std::string Declaration(const Scene& s, int N, const std::string& integrator, double max_step,
+                        double substeps) {
+  std::ostringstream d;
+  d.precision(17);
+  d << s.declaration << " segments=" << N << " integrator=" << integrator;
+  if (max_step > 0) d << " max_step=" << max_step;
+  if (substeps > 0) d << " substeps=" << static_cast<int>(substeps);
+  return d.str();
+}
+
+std::optional<Tether> MakeTether(const Scene& s, int N, const std::string& integrator,
+                                 double max_step, int substeps, std::string* error) {
+  Environment env;
+  env.gravity = s.gravity;
+  if (!s.water.empty()) {
+    DeclarationError e;
+    std::optional<Water> w = ParseWater(s.water, &e);
+    if (!w) {
+      *error = e.message;
+      return std::nullopt;
+    }
+    env.wet = true;
+    env.water = *w;
+  }
+  const std::string ends = s.b ? "ends=a,b " : "ends=a,free ";
+  DeclarationError e;
+  std::optional<TetherDeclaration> decl =
+      ParseTether(ends + Declaration(s, N, integrator, max_step, substeps), env, &e);
+  if (!decl) {
+    *error = e.message;
+    return std::nullopt;
+  }
+  return Tether::Create(decl->params, env, error);
+}
+
+Ends EndsAt(const Scene& s, double t) {
+  Ends e;
+  e.a = s.a(t);
+  if (s.b) e.b = s.b(t);
+  return e;
+}
+
+// Runs the scene with outer step `outer` (tether steps per outer step from max_step).
+Run RunEngine(const Scene& s, int N, const std::string& integrator, double outer, double max_step,
+              bool keep_nodes) {
+  Run r;
+  r.scene = s.name;
+  r.path = "engine";
+  r.integrator = integrator;
+  r.segments = N;
+  r.outer = outer;
+  std::string error;
+  std::optional<Tether> t = MakeTether(s, N, integrator, max_step, 0, &error);
+  if (!t) {
+    std::fprintf(stderr, "%s: %s\n", s.name.c_str(), error.c_str());
+    std::exit(2);
+  }
+  r.step = outer / t->SubstepsFor(outer);
+  std::vector<double> x(3 * t->nodes()), v(3 * t->nodes()), work(t->WorkspaceSize());
+  const long steps = std::lround(s.duration / outer);
+  const long every = std::max(1L, std::lround(s.sample / outer));
+  auto record = [&](const Ends& ends) {
+    EndReactions re = t->Reactions(x.data(), v.data(), ends, work.data());
+    r.T.push_back(s.b ? re.tension_b : re.tension_a);
+    if (keep_nodes) {
+      std::vector<Vec3> nodes(t->nodes());
+      for (int i = 0; i < t->nodes(); ++i) nodes[i] = Vec3(&x[3 * i]);
+      r.x.push_back(std::move(nodes));
+    }
+  };
+  // Timed: the stepping and the reaction at each outer step (as the MuJoCo callback does).
+  const auto start = Clock::now();
+  Ends from = EndsAt(s, 0);
+  t->InitialShape(from, x.data(), v.data());
+  double sink = 0;
+  for (long k = 0; k < steps; ++k) {
+    if (k % every == 0) {
+      const auto pause = Clock::now();
+      record(from);
+      r.wall -= std::chrono::duration<double>(Clock::now() - pause).count();
+    }
+    const Ends to = EndsAt(s, (k + 1) * outer);
+    StepStatus st = t->Advance(x.data(), v.data(), from, to, outer, work.data());
+    if (!st.ok) {
+      r.ok = false;
+      break;
+    }
+    sink += t->Reactions(x.data(), v.data(), to, work.data()).tension_a;
+    from = to;
+  }
+  r.wall += std::chrono::duration<double>(Clock::now() - start).count();
+  if (r.ok) record(from);
+  if (!(sink >= 0)) r.ok = false;
+  return r;
+}
+
+// ------------------------------------------------------------------------------------------
+// The fixed scene through MuJoCo: the tether between a world site and a mocap body.
+
+std::string LineMjcf(const Scene& s, int N, const std::string& integrator, double h,
+                     double max_step) {
+  std::ostringstream x;
+  x.precision(17);
+  x << "<mujoco><option timestep=\"" << h << "\"/><custom>"
+    << "<text name=\"water\" data=\"" << s.water << "\"/>"
+    << "<text name=\"tether:line\" data=\"ends=anchor,fair "
+    << Declaration(s, N, integrator, max_step, 0) << "\"/></custom><worldbody>"
+    << "<site name=\"anchor\" pos=\"0 0 -150\"/>"
+    << "<body name=\"fairlead\" mocap=\"true\" pos=\"80 0 -100\"><site name=\"fair\"/></body>"
+    << "</worldbody></mujoco>";
+  return x.str();
+}
+
+Run RunMujoco(const Scene& s, int N, const std::string& integrator, double h, double max_step) {
+  Run r;
+  r.scene = s.name;
+  r.path = "mujoco";
+  r.integrator = integrator;
+  r.segments = N;
+  r.outer = h;
+  std::string error;
+  mjModel* m = LoadModelFromString(LineMjcf(s, N, integrator, h, max_step), "line.xml", &error);
+  if (!m) {
+    std::fprintf(stderr, "%s\n", error.c_str());
+    std::exit(2);
+  }
+  mjData* d = mj_makeData(m);
+  r.step = h / GetTether(m, 0)->SubstepsFor(h);
+  const long steps = std::lround(s.duration / h);
+  const long every = std::max(1L, std::lround(s.sample / h));
+  const auto start = Clock::now();
+  for (long k = 0; k <= steps; ++k) {
+    const Vec3 p = s.b(k * h).pos;  // the fairlead at the time of this step
+    for (int i = 0; i < 3; ++i) d->mocap_pos[i] = p[i];
+    mj_step(m, d);  // the callback advances the tether to k h and applies the reactions
+    if (CheckDivergence(m, d)) {
+      r.ok = false;
+      break;
+    }
+    if (k % every == 0) r.T.push_back(GetReactions(m, d, 0).tension_b);
+  }
+  r.wall = std::chrono::duration<double>(Clock::now() - start).count();
+  mj_deleteData(d);
+  Detach(m);
+  mj_deleteModel(m);
+  return r;
+}
+
+// ------------------------------------------------------------------------------------------
+// The fixed scene as a MuJoCo 2.2 user would build it without this project: a
+// <composite type="rope"> chain of rigid capsules (two hinges per joint, no stretch), MuJoCo's
+// inertia-box fluid drag from <option density>, buoyancy applied by the user through
+// xfrc_applied, the fairlead held by an equality connect to the mocap body. The initial shape
+// is the same inextensible catenary as the tether's (the joint angles are set from it).
+
+std::string RopeMjcf(const Scene& s, int links, double h, const std::vector<Vec3>& shape) {
+  const double L = 100, d = 0.025, mu = 1.0, sp = L / links;
+  // The root element rB0 carries the ball joint at the anchor; its centre is half a link out.
+  const Vec3 dir0 = (shape[1] - shape[0]).normalized();
+  const Vec3 c0 = shape[0] + 0.5 * sp * dir0;
+  (void)s;
+  std::ostringstream x;
+  x.precision(17);
+  x << "<mujoco><option timestep=\"" << h << "\" density=\"1025\"/>"
+    << "<size njmax=\"100\" nconmax=\"10\"/><worldbody>"
+    << "<body name=\"fairlead\" mocap=\"true\" pos=\"80 0 -100\"/>"
+    << "<body name=\"rB0\" pos=\"" << c0.x() << " " << c0.y() << " " << c0.z() << "\">"
+    << "<joint type=\"ball\" pos=\"" << -0.5 * sp << " 0 0\"/>"
+    << "<composite type=\"rope\" count=\"" << links << " 1 1\" spacing=\"" << sp
+    << "\" prefix=\"r\"><joint kind=\"main\" damping=\"0\"/>"
+    << "<geom type=\"capsule\" size=\"" << d / 2 << " " << 0.5 * sp - d / 2 << "\" mass=\""
+    << mu * sp << "\" contype=\"0\" conaffinity=\"0\"/></composite></body></worldbody>"
+    << "<equality><connect body1=\"rB" << links - 1 << "\" body2=\"fairlead\" anchor=\"" << 0.5 * sp
+    << " 0 0\"/></equality></mujoco>";
+  return x.str();
+}
+
+Run RunRope(const Scene& s, int links, double h) {
+  Run r;
+  r.scene = s.name;
+  r.path = "composite";
+  r.integrator = "rope";
+  r.segments = links;
+  r.step = r.outer = h;
+  // Inextensible catenary through the two ends, as the tether starts.
+  std::string error;
+  std::optional<Tether> t = MakeTether(s, links, "explicit", 0, 0, &error);
+  std::vector<double> xs(3 * (links + 1)), vs(3 * (links + 1));
+  t->InitialShape(EndsAt(s, 0), xs.data(), vs.data());
+  std::vector<Vec3> shape(links + 1);
+  for (int i = 0; i <= links; ++i) shape[i] = Vec3(&xs[3 * i]);
+
+  char buf[1000] = "";
+  const std::string xml = RopeMjcf(s, links, h, shape);
+  auto vfs = std::make_unique<mjVFS>();
+  mj_defaultVFS(vfs.get());
+  mj_makeEmptyFileVFS(vfs.get(), "rope.xml", static_cast<int>(xml.size()));
+  std::memcpy(vfs->filedata[mj_findFileVFS(vfs.get(), "rope.xml")], xml.data(), xml.size());
+  mjModel* m = mj_loadXML("rope.xml", vfs.get(), buf, sizeof(buf));
+  mj_deleteVFS(vfs.get());
+  if (!m) {
+    std::fprintf(stderr, "rope: %s\n", buf);
+    std::exit(3);
+  }
+  mjData* d = mj_makeData(m);
+  // Joint angles from the shape (all in the x-z plane): link k points along
+  // (cos phi, 0, -sin phi), a rotation by phi about y; the hinges about y take the differences.
+  std::vector<double> phi(links);
+  for (int k = 0; k < links; ++k) {
+    const Vec3 e = shape[k + 1] - shape[k];
+    phi[k] = std::atan2(-e.z(), e.x());
+  }
+  d->qpos[0] = std::cos(phi[0] / 2);
+  d->qpos[1] = 0;
+  d->qpos[2] = std::sin(phi[0] / 2);
+  d->qpos[3] = 0;
+  for (int j = 0; j < m->njnt; ++j) {
+    if (m->jnt_type[j] != mjJNT_HINGE) continue;
+    const int body = m->jnt_bodyid[j];
+    const int k = body - m->jnt_bodyid[0];  // link index
+    const double* axis = m->jnt_axis + 3 * j;
+    if (std::abs(axis[1]) > 0.5) d->qpos[m->jnt_qposadr[j]] = phi[k] - phi[k - 1];
+  }
+  const int fair = mj_name2id(m, mjOBJ_BODY, "fairlead");
+  const int first = m->jnt_bodyid[0];
+  // Buoyancy of each link, the user's own upward force at its centre.
+  const double buoy = 1025 * kPi * 0.025 * 0.025 / 4 * (100.0 / links) * 9.81;
+  const long steps = std::lround(s.duration / h);
+  const long every = std::max(1L, std::lround(s.sample / h));
+  const auto start = Clock::now();
+  for (long k = 0; k <= steps; ++k) {
+    const Vec3 p = s.b(k * h).pos;
+    for (int i = 0; i < 3; ++i) d->mocap_pos[3 * m->body_mocapid[fair] + i] = p[i];
+    for (int b = first; b < first + links; ++b) d->xfrc_applied[6 * b + 2] = buoy;
+    mj_step(m, d);
+    bool finite = true;
+    for (int i = 0; i < m->nq; ++i) finite = finite && std::isfinite(d->qpos[i]);
+    if (!finite) {
+      r.ok = false;
+      break;
+    }
+    if (k % every == 0) {
+      // Fairlead tension: the connect constraint's force (rows of equality 0), after the step's
+      // solve (it belongs to the state at the start of this step).
+      Vec3 f = Vec3::Zero();
+      int row = 0;
+      for (int i = 0; i < d->nefc; ++i) {
+        if (d->efc_type[i] == mjCNSTR_EQUALITY && d->efc_id[i] == 0 && row < 3) {
+          f[row++] = d->efc_force[i];
+        }
+      }
+      r.T.push_back(f.norm());
+    }
+  }
+  r.wall = std::chrono::duration<double>(Clock::now() - start).count();
+  mj_deleteData(d);
+  mj_deleteModel(m);
+  return r;
+}
+
+// ------------------------------------------------------------------------------------------
+// Errors
+
+double RmsDiff(const std::vector<double>& a, const std::vector<double>& b) {
+  const size_t n = std::min(a.size(), b.size());
+  if (n == 0 || a.size() != b.size()) return NAN;
+  double s = 0;
+  for (size_t i = 0; i < n; ++i) s += (a[i] - b[i]) * (a[i] - b[i]);
+  return std::sqrt(s / n);
+}
+
+// RMS over samples of the largest distance between a run's node and the reference node at the
+// same arc length (the reference has a multiple of the run's segments).
+double NodeError(const Run& r, const Run& ref) {
+  if (r.x.empty() || r.x.size() != ref.x.size()) return NAN;
+  const int N = r.segments, Nref = ref.segments;
+  if (Nref % N != 0) return NAN;
+  double s = 0;
+  for (size_t k = 0; k < r.x.size(); ++k) {
+    double worst = 0;
+    for (int i = 0; i <= N; ++i) {
+      worst = std::max(worst, (r.x[k][i] - ref.x[k][i * (Nref / N)]).norm());
+    }
+    s += worst * worst;
+  }
+  return std::sqrt(s / r.x.size());
+}
+
+// Converged reference of one N: explicit at 1/4 and 1/8 of its stable step, Richardson-
+// extrapolated (symplectic Euler is first order).
+Run Reference(const Scene& s, int N) {
+  std::string error;
+  const double h = MakeTether(s, N, "explicit", 0, 0, &error)->ExplicitStableStep();
+  const double outer = s.sample / std::ceil(s.sample / 0.002);
+  Run a = RunEngine(s, N, "explicit", outer, h / 4, true);
+  Run b = RunEngine(s, N, "explicit", outer, h / 8, true);
+  Run r = b;
+  for (size_t k = 0; k < r.T.size(); ++k) r.T[k] = 2 * b.T[k] - a.T[k];
+  for (size_t k = 0; k < r.x.size(); ++k) {
+    for (size_t i = 0; i < r.x[k].size(); ++i) r.x[k][i] = 2 * b.x[k][i] - a.x[k][i];
+  }
+  std::fprintf(stderr, "  reference %s N=%d: h=%.3g s, Richardson correction RMS %.3g N (%.1f s)\n",
+               s.name.c_str(), N, h / 8, RmsDiff(a.T, b.T), a.wall + b.wall);
+  return r;
+}
+
+// ------------------------------------------------------------------------------------------
+
+struct Options {
+  bool quick = false;
+  std::string out = ".";
+  std::vector<std::string> scenes = {"line", "catenary", "swing", "snap", "slack"};
+  std::vector<double> steps = {0.05, 0.02, 0.01, 0.005, 0.002, 0.001};  // [s] implicit steps
+};
+
+void Print(FILE* csv, const Run& r) {
+  const double per_s = r.wall / (r.scene.empty() ? 1 : 1);
+  (void)per_s;
+  std::fprintf(csv, "%s,%s,%s,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d\n", r.scene.c_str(),
+               r.path.c_str(), r.integrator.c_str(), r.segments, r.step, r.outer, r.wall, r.err_T,
+               r.err_T_time, r.err_x, r.ok ? 1 : 0);
+}
+
+}  // namespace
+}  // namespace mjtether
+
+int main(int argc, char** argv) {
+  using namespace mjtether;
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    if (a == "--quick")
+      o.quick = true;
+    else if (a == "--out" && i + 1 < argc)
+      o.out = argv[++i];
+    else if (a == "--steps" && i + 1 < argc) {
+      o.steps.clear();
+      std::stringstream ss(argv[++i]);
+      std::string item;
+      while (std::getline(ss, item, ',')) o.steps.push_back(std::stod(item));
+    } else if (a == "--scenes" && i + 1 < argc) {
+      o.scenes.clear();
+      std::stringstream ss(argv[++i]);
+      std::string item;
+      while (std::getline(ss, item, ',')) o.scenes.push_back(item);
+    } else {
+      std::fprintf(stderr, "usage: accuracy_cost [--quick] [--scenes a,b] [--out DIR]\n");
+      return 2;
+    }
+  }
+  InstallErrorHandlers();
+  std::map<std::string, Scene> all = {{"line", LineScene()},
+                                      {"catenary", CatenaryScene()},
+                                      {"swing", SwingScene()},
+                                      {"snap", SnapScene()},
+                                      {"slack", SlackScene()}};
+  std::vector<Run> runs;
+  for (const std::string& name : o.scenes) {
+    if (!all.count(name)) {
+      std::fprintf(stderr, "unknown scene %s\n", name.c_str());
+      return 2;
+    }
+    Scene s = all[name];
+    if (o.quick) {
+      s.segments = {10, 20};
+      s.reference_segments = 40;
+    }
+    std::fprintf(stderr, "scene %s\n", name.c_str());
+    Run finest = Reference(s, s.reference_segments);
+    std::map<int, Run> ref_n;
+    for (int N : s.segments) {
+      ref_n[N] = N == s.reference_segments ? finest : Reference(s, N);
+    }
+    const std::vector<double>& steps = o.steps;
+    auto finish = [&](Run r) {
+      if (r.ok) {
+        if (s.static_reference) {
+          r.err_T = std::abs(r.T.back() - s.static_tension);
+          r.err_T_time = std::abs(r.T.back() - ref_n[r.segments].T.back());
+        } else {
+          r.err_T = RmsDiff(r.T, finest.T);
+          r.err_T_time = RmsDiff(r.T, ref_n[r.segments].T);
+          r.err_x = NodeError(r, finest);
+        }
+      }
+      std::fprintf(stderr, "  %-9s %-8s N=%3d h=%.2g: %.3g ms/s, err_T %.3g N (time %.3g)\n",
+                   r.path.c_str(), r.integrator.c_str(), r.segments, r.step,
+                   1e3 * r.wall / s.duration, r.err_T, r.err_T_time);
+      if (const char* dump = std::getenv("ACCURACY_COST_DUMP")) {
+        // Debugging aid: the tension series of every run, and of the references.
+        std::ostringstream f;
+        f << dump << "/" << r.scene << "_" << r.path << "_" << r.integrator << "_" << r.segments
+          << "_" << r.step << ".txt";
+        FILE* out = std::fopen(f.str().c_str(), "w");
+        for (size_t k = 0; k < r.T.size() && k < finest.T.size(); ++k) {
+          std::fprintf(out, "%g %.9g %.9g %.9g\n", k * s.sample, r.T[k], finest.T[k],
+                       ref_n[r.segments].T[k]);
+        }
+        std::fclose(out);
+      }
+      r.x.clear();
+      runs.push_back(std::move(r));
+    };
+    for (int N : s.segments) {
+      finish(RunEngine(s, N, "explicit", 0.002, 0, true));
+      for (double h : steps) {
+        if (h > s.sample + 1e-12) continue;
+        finish(RunEngine(s, N, "implicit", h, 0, true));
+        finish(RunEngine(s, N, "implicit2", h, 0, true));
+      }
+    }
+    if (name == "line" && !o.quick) {
+      for (int N : {20, 80}) {
+        finish(RunMujoco(s, N, "explicit", 0.002, 0));
+        for (double h : {0.01, 0.002}) finish(RunMujoco(s, N, "implicit", h, 0));
+      }
+      for (int links : {10, 20, 40}) {
+        for (double h : {0.002, 0.001}) finish(RunRope(s, links, h));
+      }
+    }
+  }
+  const std::string csv_path = o.out + "/accuracy_cost.csv";
+  FILE* csv = std::fopen(csv_path.c_str(), "w");
+  std::fprintf(csv,
+               "scene,path,integrator,segments,step_s,outer_s,wall_s,err_T_N,"
+               "err_T_time_N,err_x_m,ok\n");
+  for (const Run& r : runs) Print(csv, r);
+  std::fclose(csv);
+  return 0;
+}
