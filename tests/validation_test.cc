@@ -352,36 +352,42 @@ TEST(Validation, CatenaryOnSeabedWithFriction) {
 TEST(Validation, CantileverSelfWeight) {
   const double L = 1, mu = 0.1, EI = 100, q = mu * kG;
   const double ref = q * std::pow(L, 4) / (8 * EI), ref_moment = q * L * L / 2;
-  std::vector<std::pair<int, double>> e;
-  double tip40 = 0;
-  for (int N : {10, 20, 40, 80}) {
-    TetherParams p;
-    p.length = L;
-    p.segments = N;
-    p.diameter = 0.01;
-    p.mass_per_length = mu;
-    p.EA = 1e7;
-    p.EI = EI;
-    p.clamp_a = true;
-    p.free_end = true;
-    Sim s(Make(p, Environment()));
-    ASSERT_TRUE(s.tether.params().effects & kClamp);
-    s.ends.a.axis = Vec3::UnitX();
-    for (int i = 0; i <= N; ++i) s.set(i, Vec3(L * i / N, 0, 0));
-    ASSERT_TRUE(s.Settle(0.01, 20000, 1e-12)) << N;
-    const double tip = -s.node(N).z();
-    e.emplace_back(N, tip / ref - 1);
-    const EndReactions r = s.Reactions();
-    // The wall carries the weight and its moment: torque_a = sum x_i x W_i = +y q L^2/2.
-    EXPECT_NEAR(r.torque_a.y() / ref_moment, 1, 1e-3) << N;
-    EXPECT_NEAR(r.force_a.z() / (q * L), -1, 1e-6) << N;
-    if (N == 40) tip40 = tip;
+  int row = 0;
+  for (Bending bending : {Bending::kGalerkin, Bending::kDER}) {
+    std::vector<std::pair<int, double>> e;
+    double tip40 = 0;
+    for (int N : {10, 20, 40, 80}) {
+      TetherParams p;
+      p.length = L;
+      p.segments = N;
+      p.diameter = 0.01;
+      p.mass_per_length = mu;
+      p.EA = 1e7;
+      p.EI = EI;
+      p.clamp_a = true;
+      p.free_end = true;
+      p.bending = bending;
+      Sim s(Make(p, Environment()));
+      ASSERT_TRUE(s.tether.params().effects & kClamp);
+      s.ends.a.axis = Vec3::UnitX();
+      for (int i = 0; i <= N; ++i) s.set(i, Vec3(L * i / N, 0, 0));
+      ASSERT_TRUE(s.Settle(0.01, 20000, 1e-12)) << N;
+      const double tip = -s.node(N).z();
+      e.emplace_back(N, tip / ref - 1);
+      const EndReactions r = s.Reactions();
+      // The wall carries the weight and its moment: torque_a = sum x_i x W_i = +y q L^2/2.
+      EXPECT_NEAR(r.torque_a.y() / ref_moment, 1, 1e-3) << N;
+      EXPECT_NEAR(r.force_a.z() / (q * L), -1, 1e-6) << N;
+      if (N == 40) tip40 = tip;
+    }
+    // Discretisation: the clamp's one-sided curvature (weight L0/2) and the lumped load.
+    EXPECT_NEAR(e[2].second, 0, 0.005);
+    EXPECT_NEAR(LastOrder(e), 2, 0.5);
+    Record(row++, {std::string("3. Cantilever, self-weight (qL³/EI = 0.01), bending=") +
+                       (bending == Bending::kDER ? "der" : "galerkin") + ": tip deflection",
+                   "qL⁴/(8EI) " + Format("%.6g m", ref), Format("%.6g m", tip40),
+                   Percent(e[2].second), "0.5%, order 2 ± 0.5", Orders(e), 40});
   }
-  // Discretisation: the clamp's one-sided curvature (weight L0/2) and the lumped load.
-  EXPECT_NEAR(e[2].second, 0, 0.005);
-  Record(0, {"3. Cantilever, self-weight (qL³/EI = 0.01): tip deflection",
-             "qL⁴/(8EI) " + Format("%.6g m", ref), Format("%.6g m", tip40),
-             Percent(e[2].second), "0.5%", Orders(e), 40});
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -399,6 +405,8 @@ TEST(Validation, ConservativeForcesAreTheGradientOfTheEnergy) {
   p.EI = 20;
   p.clamp_a = p.clamp_b = true;
   Environment env;
+  for (Bending bending : {Bending::kGalerkin, Bending::kDER}) {
+  p.bending = bending;
   Tether t = Make(p, env);
   std::mt19937 rng(5);
   std::normal_distribution<double> N(0, 1);
@@ -438,6 +446,24 @@ TEST(Validation, ConservativeForcesAreTheGradientOfTheEnergy) {
     }
     ASSERT_LT(Mo.norm(), 1e-12 * mscale) << "trial " << trial;
   }
+  }
+}
+
+// bending=galerkin|der is parsed, and anything else is an error naming the key.
+TEST(Validation, BendingKeyIsParsed) {
+  Environment env;
+  const std::string base = "ends=a,b length=1 segments=4 diameter=0.01 mass_per_length=0.1 "
+                           "EA=1e3 EI=1 bending=";
+  DeclarationError e;
+  auto der = ParseTether(base + "der", env, &e);
+  ASSERT_TRUE(der.has_value()) << e.message;
+  EXPECT_EQ(der->params.bending, Bending::kDER);
+  auto galerkin = ParseTether(base + "galerkin", env, &e);
+  ASSERT_TRUE(galerkin.has_value()) << e.message;
+  EXPECT_EQ(galerkin->params.bending, Bending::kGalerkin);
+  EXPECT_FALSE(ParseTether(base + "euler", env, &e).has_value());
+  EXPECT_EQ(e.key, "bending");
+  EXPECT_NE(e.message.find("allowed: galerkin, der"), std::string::npos) << e.message;
 }
 
 // ---------------------------------------------------------------------------------------------
