@@ -1,5 +1,7 @@
 // Robustness: the time-step advisor, divergence reports, bad input through the command line,
 // concurrency, and a long run of the default scene with flat memory.
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -13,9 +15,6 @@
 #include <string>
 #include <thread>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <mujoco/mujoco.h>
 
 #include "mjtether.h"
 
@@ -136,8 +135,8 @@ TEST_F(Scene, AdvisorCoversMaxStepAndIsSilentOtherwise) {
 // load time with the count and what to change (it would otherwise run for hours).
 TEST_F(Scene, AbsurdAutomaticSubstepsAreRefused) {
   std::string error;
-  mjModel* m = LoadModelFromString(
-      LineXml("integrator=explicit", 0.002, "EA=1e13 segments=1000"), "stiff.xml", &error);
+  mjModel* m = LoadModelFromString(LineXml("integrator=explicit", 0.002, "EA=1e13 segments=1000"),
+                                   "stiff.xml", &error);
   ASSERT_EQ(m, nullptr);
   EXPECT_TRUE(Contains(error, "stiff.xml: <text name=\"tether:line\">")) << error;
   EXPECT_TRUE(Contains(error, "more than 100000")) << error;
@@ -190,9 +189,8 @@ TEST_F(Scene, KineticEnergyBlowUpIsReported) {
 
 int RunCli(const std::string& args, std::string* output) {
   const std::string out = ::testing::TempDir() + "/robust_cli_" + std::to_string(getpid());
-  const int status = std::system((std::string(MJTETHER_CLI) + " " + args + " > " + out +
-                                  " 2>&1 < /dev/null")
-                                     .c_str());
+  const int status = std::system(
+      (std::string(MJTETHER_CLI) + " " + args + " > " + out + " 2>&1 < /dev/null").c_str());
   std::ifstream f(out);
   std::stringstream s;
   s << f.rdbuf();
@@ -261,8 +259,8 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         BadInput{"missing_key", kGoodWater, BadTether("EA=1e5 ", ""), "tether:u", "EA",
                  "missing required key"},
-        BadInput{"unknown_key", kGoodWater, std::string(kGoodTether) + " colour=red",
-                 "tether:u", "colour", "allowed keys: ends, length"},
+        BadInput{"unknown_key", kGoodWater, std::string(kGoodTether) + " colour=red", "tether:u",
+                 "colour", "allowed keys: ends, length"},
         BadInput{"not_a_number", kGoodWater, BadTether("length=10", "length=ten"), "tether:u",
                  "length", "not a number"},
         BadInput{"nan", kGoodWater, BadTether("diameter=0.02", "diameter=nan"), "tether:u",
@@ -271,18 +269,17 @@ INSTANTIATE_TEST_SUITE_P(
                  "tether:u", "mass_per_length", "not a finite number"},
         BadInput{"negative", kGoodWater, BadTether("damping=5", "damping=-5"), "tether:u",
                  "damping", "[0, 1e+12]"},
-        BadInput{"zero", kGoodWater, BadTether("EA=1e5", "EA=0"), "tether:u", "EA",
-                 "(0, 1e+13]"},
-        BadInput{"huge_segments", kGoodWater, BadTether("segments=10", "segments=1e9"),
-                 "tether:u", "segments", "[1, 100000]"},
+        BadInput{"zero", kGoodWater, BadTether("EA=1e5", "EA=0"), "tether:u", "EA", "(0, 1e+13]"},
+        BadInput{"huge_segments", kGoodWater, BadTether("segments=10", "segments=1e9"), "tether:u",
+                 "segments", "[1, 100000]"},
         BadInput{"fractional_segments", kGoodWater, BadTether("segments=10", "segments=10.5"),
                  "tether:u", "segments", "whole number"},
-        BadInput{"huge_coefficient", kGoodWater, BadTether("Cdn=1.2", "Cdn=1e9"), "tether:u",
-                 "Cdn", "[0, 100]"},
-        BadInput{"bad_word", kGoodWater, std::string(kGoodTether) + " integrator=rk4",
-                 "tether:u", "integrator", "explicit, implicit"},
-        BadInput{"missing_site", kGoodWater, BadTether("ends=a,b", "ends=a,c"), "tether:u",
-                 "ends", "no site named 'c'"},
+        BadInput{"huge_coefficient", kGoodWater, BadTether("Cdn=1.2", "Cdn=1e9"), "tether:u", "Cdn",
+                 "[0, 100]"},
+        BadInput{"bad_word", kGoodWater, std::string(kGoodTether) + " integrator=rk4", "tether:u",
+                 "integrator", "explicit, implicit"},
+        BadInput{"missing_site", kGoodWater, BadTether("ends=a,b", "ends=a,c"), "tether:u", "ends",
+                 "no site named 'c'"},
         BadInput{"same_site_twice", kGoodWater, BadTether("ends=a,b", "ends=b,b"), "tether:u",
                  "ends", "both ends are on site 'b'"},
         BadInput{"one_site", kGoodWater, BadTether("ends=a,b", "ends=a"), "tether:u", "ends",
@@ -291,44 +288,42 @@ INSTANTIATE_TEST_SUITE_P(
                  "'EI' is not of the form key=value"},
         BadInput{"empty_value", kGoodWater, BadTether("EI=0.1", "EI="), "tether:u", "EI",
                  "needs both a key and a value"},
-        BadInput{"duplicate_key", kGoodWater, std::string(kGoodTether) + " EA=2e5",
-                 "tether:u", "EA", "given twice"},
+        BadInput{"duplicate_key", kGoodWater, std::string(kGoodTether) + " EA=2e5", "tether:u",
+                 "EA", "given twice"},
         BadInput{"exclusive_keys", kGoodWater,
-                 std::string(kGoodTether) + " substeps=2 max_step=0.001", "tether:u",
-                 "substeps", "exclude each other"},
+                 std::string(kGoodTether) + " substeps=2 max_step=0.001", "tether:u", "substeps",
+                 "exclude each other"},
         BadInput{"effect_not_available", "", std::string(kGoodTether) + " effects=axial,drag",
                  "tether:u", "effects", "needs a water declaration"},
         BadInput{"absurd_explicit_substeps", kGoodWater,
                  Replace(BadTether("segments=10", "segments=1000"), "EA=1e5", "EA=1e13") +
                      " integrator=explicit",
-                 "tether:u", "",
-                 "more than 100000"}),
+                 "tether:u", "", "more than 100000"}),
     BadName);
 
 INSTANTIATE_TEST_SUITE_P(
     Water, CliBadInput,
-    ::testing::Values(
-        BadInput{"water_unknown_key", std::string(kGoodWater) + " salinity=35", kGoodTether,
-                 "water", "salinity", "allowed keys: density"},
-        BadInput{"water_not_a_number", BadWater("density=1025", "density=x"), kGoodTether,
-                 "water", "density", "not a number"},
-        BadInput{"water_nan", BadWater("seabed=-20", "seabed=nan"), kGoodTether, "water",
-                 "seabed", "not a finite number"},
-        BadInput{"water_infinity", BadWater("current=0.3,0,0", "current=inf,0,0"), kGoodTether,
-                 "water", "current", "not a finite number"},
-        BadInput{"water_negative", std::string(kGoodWater) + " seabed_friction=-1",
-                 kGoodTether, "water", "seabed_friction", "[0, 10]"},
-        BadInput{"water_zero", BadWater("density=1025", "density=0"), kGoodTether, "water",
-                 "density", "(0, 10000]"},
-        BadInput{"water_huge", BadWater("current=0.3,0,0", "current=1e6,0,0"), kGoodTether,
-                 "water", "current", "[-1000, 1000]"},
-        BadInput{"water_short_vector", BadWater("current=0.3,0,0", "current=0.3,0"),
-                 kGoodTether, "water", "current", "3 numbers"},
-        BadInput{"water_malformed", std::string(kGoodWater) + " seabed", kGoodTether,
-                 "water", "", "'seabed' is not of the form key=value"},
-        BadInput{"water_seabed_keys_without_seabed",
-                 BadWater("seabed=-20", "seabed_stiffness=1e5"), kGoodTether, "water", "seabed",
-                 "no 'seabed' height"}),
+    ::testing::Values(BadInput{"water_unknown_key", std::string(kGoodWater) + " salinity=35",
+                               kGoodTether, "water", "salinity", "allowed keys: density"},
+                      BadInput{"water_not_a_number", BadWater("density=1025", "density=x"),
+                               kGoodTether, "water", "density", "not a number"},
+                      BadInput{"water_nan", BadWater("seabed=-20", "seabed=nan"), kGoodTether,
+                               "water", "seabed", "not a finite number"},
+                      BadInput{"water_infinity", BadWater("current=0.3,0,0", "current=inf,0,0"),
+                               kGoodTether, "water", "current", "not a finite number"},
+                      BadInput{"water_negative", std::string(kGoodWater) + " seabed_friction=-1",
+                               kGoodTether, "water", "seabed_friction", "[0, 10]"},
+                      BadInput{"water_zero", BadWater("density=1025", "density=0"), kGoodTether,
+                               "water", "density", "(0, 10000]"},
+                      BadInput{"water_huge", BadWater("current=0.3,0,0", "current=1e6,0,0"),
+                               kGoodTether, "water", "current", "[-1000, 1000]"},
+                      BadInput{"water_short_vector", BadWater("current=0.3,0,0", "current=0.3,0"),
+                               kGoodTether, "water", "current", "3 numbers"},
+                      BadInput{"water_malformed", std::string(kGoodWater) + " seabed", kGoodTether,
+                               "water", "", "'seabed' is not of the form key=value"},
+                      BadInput{"water_seabed_keys_without_seabed",
+                               BadWater("seabed=-20", "seabed_stiffness=1e5"), kGoodTether, "water",
+                               "seabed", "no 'seabed' height"}),
     BadName);
 
 // MuJoCo's own checks cover names given twice (two tethers of one name, two water texts, two
@@ -437,8 +432,7 @@ TEST_F(Scene, FourThreadsMatchSequentialRunsBitForBit) {
         << "run " << k;
   }
   // The runs really differ from each other (so the comparison could fail).
-  EXPECT_NE(std::memcmp(sequential[0]->qpos, sequential[2]->qpos,
-                        sizeof(mjtNum) * models[0]->nq),
+  EXPECT_NE(std::memcmp(sequential[0]->qpos, sequential[2]->qpos, sizeof(mjtNum) * models[0]->nq),
             0);
 }
 
@@ -493,10 +487,9 @@ TEST_F(Scene, DefaultSceneLongRunIsBoundedWithFlatMemory) {
     const double* x = NodePositions(m, d, k);
     const double* v = NodeVelocities(m, d, k);
     Ends ends;  // potential energy without clamps: ends unused
-    const double vehicle = 0.5 * M *
-                               (d->qvel[0] * d->qvel[0] + d->qvel[1] * d->qvel[1] +
-                                d->qvel[2] * d->qvel[2]) +
-                           M * g * d->qpos[2];
+    const double vehicle =
+        0.5 * M * (d->qvel[0] * d->qvel[0] + d->qvel[1] * d->qvel[1] + d->qvel[2] * d->qvel[2]) +
+        M * g * d->qpos[2];
     const double energy = t->KineticEnergy(x, v) + t->PotentialEnergy(x, ends) + vehicle;
     // Energies are negative (below z = 0); compare magnitudes above the lowest possible state.
     const double lowest = -M * g * (10.5 + 20 * 1.1);
@@ -508,10 +501,11 @@ TEST_F(Scene, DefaultSceneLongRunIsBoundedWithFlatMemory) {
   EXPECT_LE(emax[1], 1.1 * emax[0]) << "first half " << emax[0] << " J, second " << emax[1];
   EXPECT_EQ(d->maxuse_stack, stack_after_1s);
   EXPECT_LT(ResidentKiB() - rss_after_1s, 1024);
-  std::printf("simulated %.0f s: max tension %.1f / %.1f N (bound %.0f N), energy above "
-              "floor %.1f / %.1f J, stack %ld doubles, RSS %+ld KiB\n",
-              duration, tmax[0], tmax[1], tension_bound, emax[0], emax[1],
-              static_cast<long>(d->maxuse_stack), ResidentKiB() - rss_after_1s);
+  std::printf(
+      "simulated %.0f s: max tension %.1f / %.1f N (bound %.0f N), energy above "
+      "floor %.1f / %.1f J, stack %ld doubles, RSS %+ld KiB\n",
+      duration, tmax[0], tmax[1], tension_bound, emax[0], emax[1],
+      static_cast<long>(d->maxuse_stack), ResidentKiB() - rss_after_1s);
 }
 
 }  // namespace

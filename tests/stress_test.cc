@@ -3,6 +3,9 @@
 // stay finite, keep its energy within a stated bound and pass a physical check. Every case
 // runs with the implicit integrator at the vehicle's step of 2 ms and with the explicit one at
 // the step the advisor picks (automatic substeps of the same 2 ms call).
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -10,9 +13,6 @@
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <mujoco/mujoco.h>
 
 #include "catenary_reference.h"
 #include "declaration.h"
@@ -192,10 +192,11 @@ LoopResult RunLoop(Integrator integrator, double EI) {
 // slack segments resist shortening when EI > 0.
 TEST_P(Integrators, DISABLED_ZeroTensionLoopWithBendingIsSmooth) {
   const LoopResult r = RunLoop(GetParam(), 0.05);
-  std::printf("bending: min seg %.3f L0, arc %.4f m, extent %.3f m, dE %.2e J, KE end %.2e "
-              "max %.2e J, T %.3g N, v %.2e m/s\n",
-              r.min_segment, r.arc, r.extent, r.energy_rise, r.kinetic_end, r.kinetic_max,
-              r.tension_end, r.speed_end);
+  std::printf(
+      "bending: min seg %.3f L0, arc %.4f m, extent %.3f m, dE %.2e J, KE end %.2e "
+      "max %.2e J, T %.3g N, v %.2e m/s\n",
+      r.min_segment, r.arc, r.extent, r.energy_rise, r.kinetic_end, r.kinetic_max, r.tension_end,
+      r.speed_end);
   EXPECT_GT(r.min_segment, 0.9);
   EXPECT_NEAR(r.arc, 10, 0.2);
   EXPECT_GT(r.extent, 2.5);
@@ -213,10 +214,11 @@ TEST_P(Integrators, DISABLED_ZeroTensionLoopWithBendingIsSmooth) {
 // quadratic drag slows the last drift).
 TEST_P(Integrators, ZeroTensionWithoutBendingDoesNotJitterOrCollapse) {
   const LoopResult r = RunLoop(GetParam(), 0);
-  std::printf("no bending: min seg %.3f L0, arc %.4f m, extent %.3f m, dE %.2e J, KE end "
-              "%.2e max %.2e J, T %.3g N, v %.2e m/s\n",
-              r.min_segment, r.arc, r.extent, r.energy_rise, r.kinetic_end, r.kinetic_max,
-              r.tension_end, r.speed_end);
+  std::printf(
+      "no bending: min seg %.3f L0, arc %.4f m, extent %.3f m, dE %.2e J, KE end "
+      "%.2e max %.2e J, T %.3g N, v %.2e m/s\n",
+      r.min_segment, r.arc, r.extent, r.energy_rise, r.kinetic_end, r.kinetic_max, r.tension_end,
+      r.speed_end);
   EXPECT_GT(r.min_segment, 0.5);
   EXPECT_NEAR(r.arc, 10, 0.2);
   EXPECT_GT(r.extent, 0.2);
@@ -400,8 +402,8 @@ TEST_P(Integrators, StrongCurrentGivesDragBalancedShape) {
   const double Tmax = *std::max_element(T.begin(), T.end());
   double ymin = 1e9;
   for (int i = 1; i < s.n() - 1; ++i) ymin = std::min(ymin, s.node(i).y());
-  std::printf("current: T %.1f..%.1f N, v %.2e m/s, ymin %.2f m, KE max %.3g (bound %.3g)\n",
-              Tmin, Tmax, s.MaxSpeed(), ymin, KE_max, 0.5 * M * u * u);
+  std::printf("current: T %.1f..%.1f N, v %.2e m/s, ymin %.2f m, KE max %.3g (bound %.3g)\n", Tmin,
+              Tmax, s.MaxSpeed(), ymin, KE_max, 0.5 * M * u * u);
   EXPECT_GT(Tmin, 0);
   EXPECT_LT(Tmax / Tmin - 1, 0.01);
   EXPECT_LT(s.MaxSpeed(), 0.01);
@@ -456,9 +458,10 @@ TEST_P(Integrators, SeabedSlamEndsRestingOnTheSeabed) {
     if (std::abs(s.node(i).x()) > r - 2) continue;  // within 2 m of an end: lifted
     worst = std::max(worst, std::abs(s.node(i).z() - (zb - w / k)));
   }
-  std::printf("slam: E0 %.4g Emax-E0 %.3g, pen max %.4g (bound %.4g), rest error %.3g (w/k "
-              "%.3g), v %.2e\n",
-              E0, E_max - E0, pen_max, pen_bound, worst, w / k, s.MaxSpeed());
+  std::printf(
+      "slam: E0 %.4g Emax-E0 %.3g, pen max %.4g (bound %.4g), rest error %.3g (w/k "
+      "%.3g), v %.2e\n",
+      E0, E_max - E0, pen_max, pen_bound, worst, w / k, s.MaxSpeed());
   EXPECT_LE(E_max - E0, (GetParam() == Integrator::kExplicit ? 0.01 : 1e-9) * std::abs(E0));
   EXPECT_LT(pen_max, pen_bound);
   EXPECT_LT(worst, 0.1 * w / k);
