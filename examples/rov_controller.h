@@ -5,11 +5,12 @@
 //
 // Control law (all in the body frame, for small roll and pitch):
 //   heave force  F_z = PID(depth error) + buoyancy feed-forward - (tether force)_z
-//   yaw moment   N   = PD(heading error)
+//   yaw moment   N   = PID(heading error)
 //   roll, pitch  K, M = PD(angle) (the vertical thrusters also hold the vehicle level, like
 //                       ArduSub's "stabilize" mode: without it the Munk moment overturns the
 //                       vehicle in pitch above 0.5 m/s, see README)
-//   surge        the pilot's command [N], open loop
+//   surge        the pilot's command [N], open loop; or, in station keeping, a PID on the
+//                world horizontal position error, turned into body-frame surge and sway
 // Allocation: the four vertical thrusters at (+-x_v, +-y_v) share F_z, K, M by the
 // pseudo-inverse of their geometry; the four vectored horizontal ones share surge and yaw.
 // The tether's pull on the vehicle (mjtether::GetReactions, force on end B) is fed forward in
@@ -43,6 +44,8 @@ struct Setpoint {
   double depth = -10;   // [m] world z of the body origin
   double heading = 0;   // [rad] yaw about world z
   double surge = 0;     // [N] pilot's open-loop surge force
+  bool station = false;  // hold the horizontal position (x, y) instead of the pilot's surge
+  double x = 0, y = 0;   // [m] world position held when station is set
 };
 
 class DepthHeadingController {
@@ -73,8 +76,11 @@ class DepthHeadingController {
     // at 3 rad/s; roll and pitch at 10 rad/s, stiffer than the Munk moment's destabilising
     // (A3 - A1) U^2 = 9 N m/rad per (m/s)^2 up to 1.5 m/s.
     depth.kp = 60, depth.ki = 20, depth.kd = 80, depth.integral_limit = 40;
-    yaw.kp = 2.5, yaw.kd = 1.7;
+    yaw.kp = 2.5, yaw.ki = 1, yaw.kd = 1.7, yaw.integral_limit = 3;
     level.kp = 30, level.kd = 6;
+    // Station keeping: m + A1,2 ~ 20 kg at 0.8 rad/s, critically damped.
+    px.kp = py.kp = 13, px.ki = py.ki = 3, px.kd = py.kd = 32;
+    px.integral_limit = py.integral_limit = 40;
   }
 
   bool ok() const { return ok_; }
@@ -94,7 +100,7 @@ class DepthHeadingController {
     const double Fz = depth.Update(sp.depth - z, -vz, dt) - buoyancy_ -
                       (feed_forward_tether ? tether_force_z_ : 0);
     double heading_error = std::remainder(sp.heading - yaw_angle, 2 * M_PI);
-    const double N = yaw.kp * heading_error - yaw.kd * r;
+    const double N = yaw.Update(heading_error, -r, dt);
     const double K = -level.kp * roll - level.kd * p;
     const double M = -level.kp * pitch - level.kd * q;
 
@@ -105,18 +111,29 @@ class DepthHeadingController {
     for (int i = 0; i < 4; ++i) {
       d->ctrl[act_[4 + i]] = Fz / 4 + K * yv_[i] / sy - M * xv_[i] / sx;
     }
-    // Horizontal thrusters (gears at 45 deg): surge 0.7071 per N of ctrl each, yaw 0.1888 N m
-    // per N with signs +, -, +, - for fr, fl, rr, rl.
-    const double s = sp.surge / (4 * 0.7071), n = N / (4 * 0.1888);
-    d->ctrl[act_[0]] = s + n;
-    d->ctrl[act_[1]] = s - n;
-    d->ctrl[act_[2]] = s + n;
-    d->ctrl[act_[3]] = s - n;
+    // Horizontal force: the pilot's surge, or the station-keeping PID's world force turned
+    // into the body frame (yaw only).
+    double surge = sp.surge, sway = 0;
+    if (sp.station) {
+      const double fx = px.Update(sp.x - d->xpos[3 * body_], -qv[0], dt);
+      const double fy = py.Update(sp.y - d->xpos[3 * body_ + 1], -qv[1], dt);
+      const double c = std::cos(yaw_angle), sn = std::sin(yaw_angle);
+      surge = c * fx + sn * fy;
+      sway = -sn * fx + c * fy;
+    }
+    // Horizontal thrusters (gears at 45 deg): per N of ctrl each, surge 0.7071 N with signs
+    // +, +, +, + for fr, fl, rr, rl; sway 0.7071 N with +, -, -, +; yaw 0.1888 N m with
+    // +, -, +, -.
+    const double s = surge / (4 * 0.7071), w = sway / (4 * 0.7071), n = N / (4 * 0.1888);
+    d->ctrl[act_[0]] = s + w + n;
+    d->ctrl[act_[1]] = s - w - n;
+    d->ctrl[act_[2]] = s - w + n;
+    d->ctrl[act_[3]] = s + w - n;
   }
 
   double tether_force_z() const { return tether_force_z_; }  // [N] at the last Compute
 
-  Pid depth, yaw, level;
+  Pid depth, yaw, level, px, py;
   bool feed_forward_tether = true;  // cancel the tether's vertical pull in the heave force
 
  private:

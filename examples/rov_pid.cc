@@ -3,7 +3,10 @@
 // installed as MuJoCo's mjcb_control, while the pilot drives it away from the surface boat
 // until its 30 m tether, slack at the start, comes taut.
 //
-//   rov_pid [MODEL.xml] [--surge N] [--duration S] [--bound M]
+//   rov_pid [MODEL.xml] [--surge N] [--duration S] [--bound M] [--station]
+//
+// --station: hold the initial position (x, y) as well (station keeping; try
+// models/manoeuvre_station_keeping.xml, a 0.3 m/s cross current); the pilot's surge is unused.
 //
 // Prints, once a second: time, depth [m], heading [deg], surge speed [m/s], the tether's
 // tension at the vehicle [N] and its vertical pull [N] (mjtether::GetReactions), and its slack
@@ -39,7 +42,8 @@ void Control(const mjModel* m, mjData* d) {
 
 int main(int argc, char** argv) {
   std::string model = MJTETHER_MODELS_DIR "/bluerov2_heavy.xml";
-  double surge = 30, duration = 60, bound = 0.1;
+  double surge = 20, duration = 60, bound = 0.1;
+  bool station = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--surge" && i + 1 < argc) {
@@ -48,6 +52,8 @@ int main(int argc, char** argv) {
       duration = std::atof(argv[++i]);
     } else if (a == "--bound" && i + 1 < argc) {
       bound = std::atof(argv[++i]);
+    } else if (a == "--station") {
+      station = true;
     } else {
       model = a;
     }
@@ -71,14 +77,20 @@ int main(int argc, char** argv) {
   g_controller = &controller;
   mj_forward(m, d);                          // positions at t = 0 (xpos is zero before)
   g_setpoint.depth = d->xpos[3 * body + 2];  // hold the initial depth...
-  g_setpoint.heading = 0;                    // ...and heading
+  const double* R0 = d->xmat + 9 * body;
+  g_setpoint.heading = std::atan2(R0[3], R0[0]);  // ...and heading
+  g_setpoint.station = station;
+  g_setpoint.x = d->xpos[3 * body];
+  g_setpoint.y = d->xpos[3 * body + 1];
   mjcb_control = Control;
 
   std::vector<double> T(mjtether::GetTether(m, k)->segments());
   double worst = 0;
   long long step = 0;
   const long long per_second = std::llround(1 / m->opt.timestep);
-  std::printf("time,depth,heading_deg,surge_speed,tension,tether_pull_z,slack_segments\n");
+  double worst_station = 0;
+  std::printf("time,depth,heading_deg,surge_speed,tension,tether_pull_z,slack_segments%s\n",
+              station ? ",station_error" : "");
   while (d->time < duration) {
     g_setpoint.surge = d->time > 2 ? surge : 0;  // the pilot pushes forward after 2 s
     mjtether::Step(m, d);                        // motion: of the boat, then mj_step
@@ -87,18 +99,24 @@ int main(int argc, char** argv) {
       return 1;
     }
     const double z = d->xpos[3 * body + 2];
+    const double drift = std::hypot(d->xpos[3 * body] - g_setpoint.x,
+                                    d->xpos[3 * body + 1] - g_setpoint.y);
     if (d->time > 5) worst = std::max(worst, std::abs(z - g_setpoint.depth));
+    if (d->time > 20) worst_station = std::max(worst_station, drift);
     if (++step % per_second == 0) {
       mjtether::GetTensions(m, d, k, T.data());
       int slack = 0;
       for (double t : T) slack += t <= 0;
       const double* R = d->xmat + 9 * body;
-      std::printf("%.0f,%.4f,%.2f,%.3f,%.2f,%.2f,%d\n", d->time, z,
+      std::printf("%.0f,%.4f,%.2f,%.3f,%.2f,%.2f,%d", d->time, z,
                   std::atan2(R[3], R[0]) * 180 / M_PI, d->qvel[0],
                   mjtether::GetReactions(m, d, k).tension_b, controller.tether_force_z(), slack);
+      if (station) std::printf(",%.4f", drift);
+      std::printf("\n");
     }
   }
   std::printf("largest depth error after 5 s: %.4f m (bound %.3f m)\n", worst, bound);
+  if (station) std::printf("largest horizontal drift after 20 s: %.4f m\n", worst_station);
   mjcb_control = nullptr;
   mj_deleteData(d);
   mjtether::Detach(m);
