@@ -2,20 +2,102 @@
 #include "render.h"
 
 #include <GL/osmesa.h>
+#include <dlfcn.h>
 #include <png.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <mutex>
+#include <type_traits>
 #include <vector>
 
 #include "mjtether.h"
 
 namespace mjtether::render {
+
+// libOSMesa is opened when the first Renderer is created rather than linked: it loads LLVM,
+// which would add about 50 ms to the start of every mjtether command, rendering or not. It is
+// opened with RTLD_GLOBAL so that MuJoCo's GL loader finds OSMesaGetProcAddress in the process.
+struct OsMesaApi {
+  decltype(&OSMesaCreateContextExt) CreateContextExt = nullptr;
+  decltype(&OSMesaMakeCurrent) MakeCurrent = nullptr;
+  decltype(&OSMesaDestroyContext) DestroyContext = nullptr;
+  // The fixed-function calls that draw the water behind the scene.
+  decltype(&glPushAttrib) PushAttrib = nullptr;
+  decltype(&glPopAttrib) PopAttrib = nullptr;
+  decltype(&glDisable) Disable = nullptr;
+  decltype(&glEnable) Enable = nullptr;
+  decltype(&glDepthFunc) DepthFunc = nullptr;
+  decltype(&glDepthMask) DepthMask = nullptr;
+  decltype(&glViewport) Viewport = nullptr;
+  decltype(&glMatrixMode) MatrixMode = nullptr;
+  decltype(&glPushMatrix) PushMatrix = nullptr;
+  decltype(&glPopMatrix) PopMatrix = nullptr;
+  decltype(&glLoadIdentity) LoadIdentity = nullptr;
+  decltype(&glShadeModel) ShadeModel = nullptr;
+  decltype(&glBegin) Begin = nullptr;
+  decltype(&glEnd) End = nullptr;
+  decltype(&glColor3fv) Color3fv = nullptr;
+  decltype(&glVertex3f) Vertex3f = nullptr;
+};
+
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+
+// The OSMesa functions, or nullptr with *error set if the library cannot be opened.
+const OsMesaApi* OsMesa(std::string* error) {
+  static OsMesaApi api;
+  static std::string load_error;
+  static std::once_flag once;
+  std::call_once(once, [] {
+    void* lib = nullptr;
+    for (const char* name : {"libOSMesa.so.8", "libOSMesa.so"}) {
+      if ((lib = dlopen(name, RTLD_NOW | RTLD_GLOBAL))) break;
+    }
+    if (!lib) {
+      const char* why = dlerror();
+      load_error = std::string("OSMesa: cannot open libOSMesa.so.8 (install libosmesa6): ") +
+                   (why ? why : "");
+      return;
+    }
+    bool ok = true;
+    auto get = [&](auto& f, const char* symbol) {
+      f = reinterpret_cast<std::remove_reference_t<decltype(f)>>(dlsym(lib, symbol));
+      if (!f) {
+        ok = false;
+        load_error = std::string("OSMesa: libOSMesa has no ") + symbol;
+      }
+    };
+    get(api.CreateContextExt, "OSMesaCreateContextExt");
+    get(api.MakeCurrent, "OSMesaMakeCurrent");
+    get(api.DestroyContext, "OSMesaDestroyContext");
+    get(api.PushAttrib, "glPushAttrib");
+    get(api.PopAttrib, "glPopAttrib");
+    get(api.Disable, "glDisable");
+    get(api.Enable, "glEnable");
+    get(api.DepthFunc, "glDepthFunc");
+    get(api.DepthMask, "glDepthMask");
+    get(api.Viewport, "glViewport");
+    get(api.MatrixMode, "glMatrixMode");
+    get(api.PushMatrix, "glPushMatrix");
+    get(api.PopMatrix, "glPopMatrix");
+    get(api.LoadIdentity, "glLoadIdentity");
+    get(api.ShadeModel, "glShadeModel");
+    get(api.Begin, "glBegin");
+    get(api.End, "glEnd");
+    get(api.Color3fv, "glColor3fv");
+    get(api.Vertex3f, "glVertex3f");
+    if (!ok) api.CreateContextExt = nullptr;
+  });
+  if (!api.CreateContextExt) {
+    *error = load_error;
+    return nullptr;
+  }
+  return &api;
+}
 
 // Colour ramp of the tension scale: blue, cyan, green, yellow, red at 0, 1/4, ..., 1.
 constexpr float kRamp[5][3] = {{0.15f, 0.30f, 1.00f},
@@ -199,14 +281,17 @@ std::unique_ptr<Renderer> Renderer::Create(mjModel* m, const RenderOptions& opti
   }
 
   // OSMesa context with its own (unused) default framebuffer; MuJoCo draws off-screen.
-  OSMesaContext ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, nullptr);
+  const OsMesaApi* gl = OsMesa(error);
+  if (!gl) return nullptr;
+  r->gl_ = gl;
+  OSMesaContext ctx = gl->CreateContextExt(OSMESA_RGBA, 24, 8, 0, nullptr);
   if (!ctx) {
     *error = "OSMesa: cannot create a context (OSMesaCreateContextExt)";
     return nullptr;
   }
   r->osmesa_ = ctx;
   r->osmesa_buffer_.reset(new unsigned char[4 * o.width * o.height]);
-  if (!OSMesaMakeCurrent(ctx, r->osmesa_buffer_.get(), GL_UNSIGNED_BYTE, o.width, o.height)) {
+  if (!gl->MakeCurrent(ctx, r->osmesa_buffer_.get(), GL_UNSIGNED_BYTE, o.width, o.height)) {
     *error = "OSMesa: cannot make the context current (OSMesaMakeCurrent)";
     return nullptr;
   }
@@ -247,12 +332,12 @@ std::unique_ptr<Renderer> Renderer::Create(mjModel* m, const RenderOptions& opti
 
 Renderer::~Renderer() {
   if (osmesa_) {
-    OSMesaMakeCurrent(static_cast<OSMesaContext>(osmesa_), osmesa_buffer_.get(), GL_UNSIGNED_BYTE,
-                      opt_.width, opt_.height);
+    gl_->MakeCurrent(static_cast<OSMesaContext>(osmesa_), osmesa_buffer_.get(), GL_UNSIGNED_BYTE,
+                     opt_.width, opt_.height);
   }
   if (context_made_) mjr_freeContext(&con_);
   if (scene_made_) mjv_freeScene(&scn_);
-  if (osmesa_) OSMesaDestroyContext(static_cast<OSMesaContext>(osmesa_));
+  if (osmesa_) gl_->DestroyContext(static_cast<OSMesaContext>(osmesa_));
 }
 
 // The follow camera looks at the centre of the box that bounds the tethers' nodes and the
@@ -413,41 +498,41 @@ void Renderer::DrawHud(const mjModel* m, const mjData* d) {
 // Water behind the scene: a vertical gradient drawn at the far plane, where the depth test lets
 // it through only on pixels that nothing else covered.
 void Renderer::DrawWater() {
-  glPushAttrib(GL_ALL_ATTRIB_BITS);
-  glDisable(GL_LIGHTING);
-  glDisable(GL_TEXTURE_2D);
-  glDisable(GL_BLEND);
-  glDisable(GL_CULL_FACE);
-  glDisable(GL_FOG);
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_LEQUAL);
-  glDepthMask(GL_FALSE);
-  glViewport(0, 0, opt_.width, opt_.height);
-  glMatrixMode(GL_PROJECTION);
-  glPushMatrix();
-  glLoadIdentity();
-  glMatrixMode(GL_MODELVIEW);
-  glPushMatrix();
-  glLoadIdentity();
-  glShadeModel(GL_SMOOTH);
-  glBegin(GL_QUADS);
-  glColor3fv(kWaterBottom);
-  glVertex3f(-1, -1, 1);
-  glVertex3f(1, -1, 1);
-  glColor3fv(kWaterTop);
-  glVertex3f(1, 1, 1);
-  glVertex3f(-1, 1, 1);
-  glEnd();
-  glPopMatrix();
-  glMatrixMode(GL_PROJECTION);
-  glPopMatrix();
-  glMatrixMode(GL_MODELVIEW);
-  glPopAttrib();
+  gl_->PushAttrib(GL_ALL_ATTRIB_BITS);
+  gl_->Disable(GL_LIGHTING);
+  gl_->Disable(GL_TEXTURE_2D);
+  gl_->Disable(GL_BLEND);
+  gl_->Disable(GL_CULL_FACE);
+  gl_->Disable(GL_FOG);
+  gl_->Enable(GL_DEPTH_TEST);
+  gl_->DepthFunc(GL_LEQUAL);
+  gl_->DepthMask(GL_FALSE);
+  gl_->Viewport(0, 0, opt_.width, opt_.height);
+  gl_->MatrixMode(GL_PROJECTION);
+  gl_->PushMatrix();
+  gl_->LoadIdentity();
+  gl_->MatrixMode(GL_MODELVIEW);
+  gl_->PushMatrix();
+  gl_->LoadIdentity();
+  gl_->ShadeModel(GL_SMOOTH);
+  gl_->Begin(GL_QUADS);
+  gl_->Color3fv(kWaterBottom);
+  gl_->Vertex3f(-1, -1, 1);
+  gl_->Vertex3f(1, -1, 1);
+  gl_->Color3fv(kWaterTop);
+  gl_->Vertex3f(1, 1, 1);
+  gl_->Vertex3f(-1, 1, 1);
+  gl_->End();
+  gl_->PopMatrix();
+  gl_->MatrixMode(GL_PROJECTION);
+  gl_->PopMatrix();
+  gl_->MatrixMode(GL_MODELVIEW);
+  gl_->PopAttrib();
 }
 
 void Renderer::Render(const mjModel* m, mjData* d, unsigned char* rgb, float* depth) {
-  OSMesaMakeCurrent(static_cast<OSMesaContext>(osmesa_), osmesa_buffer_.get(), GL_UNSIGNED_BYTE,
-                    opt_.width, opt_.height);
+  gl_->MakeCurrent(static_cast<OSMesaContext>(osmesa_), osmesa_buffer_.get(), GL_UNSIGNED_BYTE,
+                   opt_.width, opt_.height);
   mjr_setBuffer(mjFB_OFFSCREEN, &con_);
   PlaceCamera(m, d);
   mjv_updateScene(m, d, &vopt_, nullptr, &cam_, mjCAT_ALL, &scn_);

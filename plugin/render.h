@@ -27,6 +27,8 @@
 
 namespace mjtether::render {
 
+struct OsMesaApi;  // libOSMesa's functions (render.cc)
+
 struct RenderOptions {
   int width = 1280;  // [pixel] even, in [16, 4096] (H.264 with yuv420p needs even sizes)
   int height = 720;  // [pixel] even, in [16, 4096]
@@ -96,7 +98,8 @@ class Renderer {
   void DrawWater();
 
   RenderOptions opt_;
-  void* osmesa_ = nullptr;  // OSMesaContext
+  const OsMesaApi* gl_ = nullptr;  // libOSMesa's functions, opened at run time
+  void* osmesa_ = nullptr;         // OSMesaContext
   std::unique_ptr<unsigned char[]> osmesa_buffer_;
   mjvScene scn_;
   mjrContext con_;
