@@ -18,11 +18,11 @@
 #ifndef MJTETHER_EXAMPLES_ROV_CONTROLLER_H_
 #define MJTETHER_EXAMPLES_ROV_CONTROLLER_H_
 
+#include <mujoco/mujoco.h>
+
 #include <algorithm>
 #include <cmath>
 #include <string>
-
-#include <mujoco/mujoco.h>
 
 #include "mjtether.h"
 
@@ -41,9 +41,9 @@ struct Pid {
 };
 
 struct Setpoint {
-  double depth = -10;   // [m] world z of the body origin
-  double heading = 0;   // [rad] yaw about world z
-  double surge = 0;     // [N] pilot's open-loop surge force
+  double depth = -10;    // [m] world z of the body origin
+  double heading = 0;    // [rad] yaw about world z
+  double surge = 0;      // [N] pilot's open-loop surge force
   bool station = false;  // hold the horizontal position (x, y) instead of the pilot's surge
   double x = 0, y = 0;   // [m] world position held when station is set
 };
@@ -141,8 +141,8 @@ class DepthHeadingController {
   int body_ = -1, tether_ = -1;
   int act_[8] = {-1, -1, -1, -1, -1, -1, -1, -1};
   double xv_[4] = {0, 0, 0, 0}, yv_[4] = {0, 0, 0, 0};  // [m] vertical thruster positions
-  double buoyancy_ = 0;                                  // [N] net upward force at rest
-  double tether_force_z_ = 0;                            // [N]
+  double buoyancy_ = 0;                                 // [N] net upward force at rest
+  double tether_force_z_ = 0;                           // [N]
 };
 
 }  // namespace rov

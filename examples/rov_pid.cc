@@ -12,14 +12,14 @@
 // tension at the vehicle [N] and its vertical pull [N] (mjtether::GetReactions), and its slack
 // segments (mjtether::GetTensions). Exit status 0 if the depth stayed within --bound [m] of the
 // set-point after the first 5 s, 1 if not, 2 on a load error.
+#include <mujoco/mujoco.h>
+
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <string>
 #include <vector>
-
-#include <mujoco/mujoco.h>
 
 #include "mjtether.h"
 #include "rov_controller.h"
@@ -68,8 +68,10 @@ int main(int argc, char** argv) {
   mjData* d = mj_makeData(m);
   rov::DepthHeadingController controller(m, "rov", "umbilical");
   if (!controller.ok()) {
-    std::fprintf(stderr, "rov_pid: %s needs a body 'rov', a tether 'umbilical' and thrusters "
-                 "fr, fl, rr, rl, vfr, vfl, vrr, vrl\n", model.c_str());
+    std::fprintf(stderr,
+                 "rov_pid: %s needs a body 'rov', a tether 'umbilical' and thrusters "
+                 "fr, fl, rr, rl, vfr, vfl, vrr, vrl\n",
+                 model.c_str());
     return 2;
   }
   const int body = mj_name2id(m, mjOBJ_BODY, "rov");
@@ -99,8 +101,8 @@ int main(int argc, char** argv) {
       return 1;
     }
     const double z = d->xpos[3 * body + 2];
-    const double drift = std::hypot(d->xpos[3 * body] - g_setpoint.x,
-                                    d->xpos[3 * body + 1] - g_setpoint.y);
+    const double drift =
+        std::hypot(d->xpos[3 * body] - g_setpoint.x, d->xpos[3 * body + 1] - g_setpoint.y);
     if (d->time > 5) worst = std::max(worst, std::abs(z - g_setpoint.depth));
     if (d->time > 20) worst_station = std::max(worst_station, drift);
     if (++step % per_second == 0) {

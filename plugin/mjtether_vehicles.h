@@ -12,9 +12,9 @@
 #ifndef MJTETHER_PLUGIN_MJTETHER_VEHICLES_H_
 #define MJTETHER_PLUGIN_MJTETHER_VEHICLES_H_
 
-#include <string>
-
 #include <mujoco/mujoco.h>
+
+#include <string>
 
 #include "vehicle.h"
 

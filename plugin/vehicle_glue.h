@@ -3,9 +3,9 @@
 #ifndef MJTETHER_PLUGIN_VEHICLE_GLUE_H_
 #define MJTETHER_PLUGIN_VEHICLE_GLUE_H_
 
-#include <string>
-
 #include <mujoco/mujoco.h>
+
+#include <string>
 
 #include "params.h"
 

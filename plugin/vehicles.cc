@@ -20,16 +20,16 @@ namespace {
 struct AttachedVehicle {
   std::string name;  // the body's name
   int body = -1;
-  int dof = -1;      // first dof of the body's free joint
+  int dof = -1;  // first dof of the body's free joint
   Vehicle vehicle;
-  int offset = 0;    // start of this vehicle's block in mjData::userdata
+  int offset = 0;  // start of this vehicle's block in mjData::userdata
 };
 
 // Layout of one vehicle's block in mjData::userdata (mj_resetData zeroes it).
 enum VehicleSlot : int {
-  kSet = 0,      // 1 once the velocity below is recorded
-  kTime,         // [s] time of the recorded velocity
-  kVel,          // [m/s] world velocity of the body origin at kTime (3)
+  kSet = 0,         // 1 once the velocity below is recorded
+  kTime,            // [s] time of the recorded velocity
+  kVel,             // [m/s] world velocity of the body origin at kTime (3)
   kAcc = kVel + 3,  // [m/s^2] its finite difference over the last step (3)
   kVehicleBlock = kAcc + 3,
 };
@@ -102,8 +102,8 @@ bool AttachVehicles(mjModel* m, const std::string& source, const Environment& en
       // viscosity > 0: its drag would be counted on top of the declared damping.
       if (m->opt.density > 0 || m->opt.viscosity > 0) {
         std::ostringstream s;
-        s << "MuJoCo's own fluid model (<option density=\"" << m->opt.density
-          << "\" viscosity=\"" << m->opt.viscosity << "\">) would also act on body '" << name
+        s << "MuJoCo's own fluid model (<option density=\"" << m->opt.density << "\" viscosity=\""
+          << m->opt.viscosity << "\">) would also act on body '" << name
           << "', on top of the declared damping; set <option density=\"0\" viscosity=\"0\"> "
              "(the water's density and current come from <text name=\"water\">)";
         return fail(s.str());

@@ -47,7 +47,7 @@ class Motion {
   Vec3 Raw(double t, Vec3* rate) const;  // unramped offset and its rate
 
   MotionParams p_;
-  double ramp_ = 0;          // [s]
+  double ramp_ = 0;           // [s]
   std::vector<double> time_;  // table times [s] (n)
   std::vector<Vec3> table_;   // table offsets [m] (n)
 };

@@ -26,10 +26,9 @@
 #ifndef MJTETHER_SRC_VEHICLE_H_
 #define MJTETHER_SRC_VEHICLE_H_
 
+#include <Eigen/Core>
 #include <optional>
 #include <string>
-
-#include <Eigen/Core>
 
 #include "params.h"
 
@@ -41,10 +40,10 @@ using Vec6 = Eigen::Matrix<double, 6, 1>;
 // surge, sway, heave, roll, pitch, yaw (body frame). Positive magnitudes of Fossen's
 // coefficients (A1 = -X_udot, D_l1 = -X_u, D_q1 = -X_u|u|, ...).
 struct VehicleParams {
-  double volume = 0;                     // [m^3] displaced volume V
-  Vec3 cob = Vec3::Zero();               // [m] centre of buoyancy, body frame
-  Vec6 added_mass = Vec6::Zero();        // [kg, kg m^2] A1..A6
-  Vec6 linear_damping = Vec6::Zero();    // [N s/m, N m s] D_l
+  double volume = 0;                      // [m^3] displaced volume V
+  Vec3 cob = Vec3::Zero();                // [m] centre of buoyancy, body frame
+  Vec6 added_mass = Vec6::Zero();         // [kg, kg m^2] A1..A6
+  Vec6 linear_damping = Vec6::Zero();     // [N s/m, N m s] D_l
   Vec6 quadratic_damping = Vec6::Zero();  // [N s^2/m^2, N m s^2] D_q
   // Include the added mass's Coriolis/centripetal terms C_A(nu_r) nu_r (the Munk moment
   // v_r x A_v v_r, w x A_v v_r, w x A_w w). Off: only the isotropic part's, which the armature
@@ -103,8 +102,8 @@ class Vehicle {
 
   VehicleParams p_;
   Environment env_;
-  double a_iso_ = 0;          // [kg] isotropic translational added mass (armature)
-  Vec3 dA_ = Vec3::Zero();    // [kg] explicit remainder, body frame
+  double a_iso_ = 0;                    // [kg] isotropic translational added mass (armature)
+  Vec3 dA_ = Vec3::Zero();              // [kg] explicit remainder, body frame
   Vec3 buoyancy_force_ = Vec3::Zero();  // [N] world frame
   bool buoyancy_ = false, added_mass_ = false, linear_ = false, quadratic_ = false;
 };

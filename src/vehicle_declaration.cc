@@ -22,9 +22,8 @@ std::string Fmt(double x) {
 
 // A comma list of `count` finite numbers (count 0: any length >= 1), each in [lo, hi] (lo
 // open when lo_open). NaN fails the comparisons.
-bool ParseList(const std::string& key, const std::string& text, int count, double lo,
-               bool lo_open, double hi, const char* what, std::vector<double>* out,
-               DeclarationError* error) {
+bool ParseList(const std::string& key, const std::string& text, int count, double lo, bool lo_open,
+               double hi, const char* what, std::vector<double>* out, DeclarationError* error) {
   const std::string range = std::string(lo_open ? "(" : "[") + Fmt(lo) + ", " + Fmt(hi) + "]";
   std::vector<std::string> items;
   std::string item;
@@ -60,9 +59,8 @@ std::string UnknownKey(const std::string& key, const std::vector<const char*>& a
 }  // namespace
 
 std::optional<VehicleParams> ParseVehicle(const std::string& text, DeclarationError* error) {
-  static const std::vector<const char*> kKeys = {"volume",         "cob",
-                                                 "added_mass",     "linear_damping",
-                                                 "quadratic_damping", "coriolis"};
+  static const std::vector<const char*> kKeys = {
+      "volume", "cob", "added_mass", "linear_damping", "quadratic_damping", "coriolis"};
   std::optional<KeyValues> pairs = SplitKeyValues(text, error);
   if (!pairs) return std::nullopt;
   VehicleParams p;
@@ -73,8 +71,7 @@ std::optional<VehicleParams> ParseVehicle(const std::string& text, DeclarationEr
       ok = ParseList(key, value, 1, 0, false, 1e4, "one volume [m^3]", &x, error);
       if (ok) p.volume = x[0];
     } else if (key == "cob") {
-      ok = ParseList(key, value, 3, -1e3, false, 1e3, "3 numbers x,y,z [m], body frame", &x,
-                     error);
+      ok = ParseList(key, value, 3, -1e3, false, 1e3, "3 numbers x,y,z [m], body frame", &x, error);
       if (ok) p.cob = Vec3(x[0], x[1], x[2]);
     } else if (key == "added_mass" || key == "linear_damping" || key == "quadratic_damping") {
       ok = ParseList(key, value, 6, 0, false, 1e9,
@@ -156,8 +153,11 @@ std::optional<Schedule> ParseSchedule(const std::string& text, DeclarationError*
       ok = ParseList(key, value, 0, 0, false, 1e7, "times [s]", &s.t, error);
       has_t = ok;
       for (size_t i = 1; ok && i < s.t.size(); ++i) {
-        if (s.t[i] < s.t[i - 1]) ok = Fail(error, key, "key 't' = " + value + ": times must not "
-                                                       "decrease");
+        if (s.t[i] < s.t[i - 1])
+          ok = Fail(error, key,
+                    "key 't' = " + value +
+                        ": times must not "
+                        "decrease");
       }
     } else if (key == "ctrl") {
       ok = ParseList(key, value, 0, -1e9, false, 1e9, "ctrl values", &s.value, error);
@@ -173,9 +173,9 @@ std::optional<Schedule> ParseSchedule(const std::string& text, DeclarationError*
     return std::nullopt;
   }
   if (s.t.size() != s.value.size()) {
-    Fail(error, "ctrl", "keys 't' and 'ctrl' must have as many values (" +
-                            std::to_string(s.t.size()) + " and " +
-                            std::to_string(s.value.size()) + ")");
+    Fail(error, "ctrl",
+         "keys 't' and 'ctrl' must have as many values (" + std::to_string(s.t.size()) + " and " +
+             std::to_string(s.value.size()) + ")");
     return std::nullopt;
   }
   return s;

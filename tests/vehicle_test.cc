@@ -1,5 +1,8 @@
 // Vehicles (Fossen hydrodynamics), prescribed motion and thrust schedules, through MuJoCo.
 // Models inline; each result is compared with a closed form.
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
+
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -8,10 +11,8 @@
 #include <string>
 #include <vector>
 
-#include <gtest/gtest.h>
-#include <mujoco/mujoco.h>
-
 #include "mjtether.h"
+#include "rov_controller.h"  // examples/: the controller example's control law
 #include "vehicle_declaration.h"
 
 namespace mjtether {
@@ -89,13 +90,15 @@ std::string VehicleXml(const Scene& s) {
   x.precision(17);
   x << R"(<mujoco><option timestep=")" << s.timestep << R"(" gravity=")" << s.gravity
     << R"(" integrator="Euler" )" << s.option << R"(/><custom>
-      <text name="water" data="density=1025 current=)" << s.current << R"("/>
-      <text name="vehicle:rov" data="volume=)" << s.volume << " cob=" << s.cob
-    << " added_mass=" << s.added_mass << " linear_damping=" << s.linear
-    << " quadratic_damping=" << s.quadratic << R"("/></custom>
-    <worldbody><body name="rov" pos="0 0 -10" quat=")" << s.quat << R"("><freejoint/>
-      <inertial pos="0 0 0" mass=")" << kMass << R"(" diaginertia=")" << kInertia << " "
-    << kInertia << " " << kInertia << R"("/>
+      <text name="water" data="density=1025 current=)"
+    << s.current << R"("/>
+      <text name="vehicle:rov" data="volume=)"
+    << s.volume << " cob=" << s.cob << " added_mass=" << s.added_mass
+    << " linear_damping=" << s.linear << " quadratic_damping=" << s.quadratic << R"("/></custom>
+    <worldbody><body name="rov" pos="0 0 -10" quat=")"
+    << s.quat << R"("><freejoint/>
+      <inertial pos="0 0 0" mass=")"
+    << kMass << R"(" diaginertia=")" << kInertia << " " << kInertia << " " << kInertia << R"("/>
       <geom type="sphere" size="0.2" contype="0" conaffinity="0"/>
     </body></worldbody></mujoco>)";
   return x.str();
@@ -152,8 +155,8 @@ TEST_F(VehicleTest, CurrentCarriesTheVehicleAsItsDampingAndAddedMassSay) {
     double A, a, b;
   };
   const double u = 0.5;  // [m/s]
-  for (const Axis& ax : {Axis{0, "0.5,0,0", 5.5, 4.03, 18.18}, Axis{1, "0,0.5,0", 12.7, 6.22,
-                                                                   21.66}}) {
+  for (const Axis& ax :
+       {Axis{0, "0.5,0,0", 5.5, 4.03, 18.18}, Axis{1, "0,0.5,0", 12.7, 6.22, 21.66}}) {
     Scene s;
     s.current = ax.current;
     mjModel* m = Load(VehicleXml(s));
@@ -183,16 +186,15 @@ TEST_F(VehicleTest, AddedMassTwiceTheBodyMassIsStableAndCorrect) {
   Scene s;
   s.gravity = "0 0 0";
   s.volume = 0;
-  const double A[6] = {2 * kMass, 2 * kMass, 2.5 * kMass, 2 * kInertia, 2 * kInertia,
-                       2 * kInertia};
+  const double A[6] = {2 * kMass, 2 * kMass, 2.5 * kMass, 2 * kInertia, 2 * kInertia, 2 * kInertia};
   std::ostringstream am;
   am.precision(17);
   for (int i = 0; i < 6; ++i) am << (i ? "," : "") << A[i];
   s.added_mass = am.str();
   s.linear = s.quadratic = "0,0,0,0,0,0";
   // yaw 30 deg then roll 20 deg
-  const Eigen::Quaterniond q = Eigen::AngleAxisd(kPi / 6, Vec3::UnitZ()) *
-                               Eigen::AngleAxisd(kPi / 9, Vec3::UnitX());
+  const Eigen::Quaterniond q =
+      Eigen::AngleAxisd(kPi / 6, Vec3::UnitZ()) * Eigen::AngleAxisd(kPi / 9, Vec3::UnitX());
   std::ostringstream quat;
   quat.precision(17);
   quat << q.w() << " " << q.x() << " " << q.y() << " " << q.z();
@@ -289,7 +291,8 @@ TEST_F(VehicleTest, BadVehicleDeclarationsNameTheKey) {
   };
   for (const Case& c : cases) {
     const std::string xml = R"(<mujoco><custom><text name="water" data="density=1025"/>
-        <text name="vehicle:rov" data=")" + c.data + R"("/></custom>
+        <text name="vehicle:rov" data=")" +
+                            c.data + R"("/></custom>
         <worldbody><body name="rov"><freejoint/><geom type="sphere" size="0.1" mass="11.5"/>
         </body></worldbody></mujoco>)";
     const std::string error = LoadError(xml);
@@ -391,7 +394,8 @@ TEST_F(VehicleTest, PrescribeMovesMocapBodiesAndTheTetherEndFollowsExactly) {
     f << "time,x,y,z\n0,0,0,0\n1,1,0,0.5\n3,1,2,0.5\n";
   }
   const std::string xml = R"(<mujoco><option timestep="0.01"/><custom>
-      <text name="motion:ship" data="csv=)" + csv + R"("/>
+      <text name="motion:ship" data="csv=)" +
+                          csv + R"("/>
       <text name="thrust:push" data="t=0,1 ctrl=0,20"/>
       <text name="tether:line" data="ends=fairlead,tip length=5 segments=5 diameter=0.01
             mass_per_length=0.1 EA=1e4"/></custom>
@@ -415,7 +419,7 @@ TEST_F(VehicleTest, PrescribeMovesMocapBodiesAndTheTetherEndFollowsExactly) {
     }
   }
   Prescribe(m, d);
-  EXPECT_NEAR(d->mocap_pos[0], 2, 1e-12);  // 1 + x offset 1
+  EXPECT_NEAR(d->mocap_pos[0], 2, 1e-12);     // 1 + x offset 1
   EXPECT_NEAR(d->mocap_pos[1], 2 + 1, 1e-9);  // halfway from y = 0 to 2 between t = 1 and 3
   EXPECT_NEAR(d->mocap_pos[2], 3.5, 1e-12);
   EXPECT_EQ(d->ctrl[0], 20);
@@ -442,8 +446,8 @@ TEST_F(VehicleTest, MunkMomentOverturnsPitchAboveTheCriticalSpeed) {
     bool coriolis;
     bool overturns;
   };
-  for (const Case& c : {Case{0.7 * Uc, true, false}, Case{1.4 * Uc, true, true},
-                        Case{1.4 * Uc, false, false}}) {
+  for (const Case& c :
+       {Case{0.7 * Uc, true, false}, Case{1.4 * Uc, true, true}, Case{1.4 * Uc, false, false}}) {
     Scene s;
     if (!c.coriolis) s.quadratic = std::string(kQuadratic) + " coriolis=0";
     const double theta0 = kPi / 180;
@@ -457,7 +461,7 @@ TEST_F(VehicleTest, MunkMomentOverturnsPitchAboveTheCriticalSpeed) {
     d->qvel[0] = c.speed;
     double max_pitch = 0;
     while (d->time < 30) {
-      const double* R = d->xmat + 9;  // body 1, row-major
+      const double* R = d->xmat + 9;                                      // body 1, row-major
       for (int i = 0; i < 3; ++i) d->xfrc_applied[6 + i] = F * R[3 * i];  // along body x
       mj_step(m, d);
       // pitch: angle of the body x-axis out of the horizontal plane
@@ -513,16 +517,18 @@ TEST_F(VehicleTest, SurgeUntilTautShowsTheTethersPull) {
       const Vec3 p(d->xpos + 3 * rov), s(d->site_xpos + 3 * surface);
       r.max_distance = std::max(r.max_distance, (p - s).norm());
       if (d->time > 13) r.min_vx_after = std::min(r.min_vx_after, d->qvel[0]);
-      if (TetherCount(m) > 0) r.max_tension = std::max(r.max_tension, GetReactions(m, d, 0).tension_b);
+      if (TetherCount(m) > 0)
+        r.max_tension = std::max(r.max_tension, GetReactions(m, d, 0).tension_b);
     }
     return r;
   };
   const Result with = run(xml, "surge.xml"), without = run(untethered, "surge_free.xml");
   const double L = 30, EA = 6e4;
-  std::printf("max distance %.2f m with the tether, %.2f m without; T_max %.1f N; min v_x "
-              "after the thrust %.3f / %.3f m/s\n",
-              with.max_distance, without.max_distance, with.max_tension, with.min_vx_after,
-              without.min_vx_after);
+  std::printf(
+      "max distance %.2f m with the tether, %.2f m without; T_max %.1f N; min v_x "
+      "after the thrust %.3f / %.3f m/s\n",
+      with.max_distance, without.max_distance, with.max_tension, with.min_vx_after,
+      without.min_vx_after);
   EXPECT_LT(with.max_distance, L * (1 + with.max_tension / EA) + 0.25);
   EXPECT_GT(without.max_distance, L + 5);
   EXPECT_LT(with.min_vx_after, 0);
@@ -531,8 +537,6 @@ TEST_F(VehicleTest, SurgeUntilTautShowsTheTethersPull) {
 
 }  // namespace
 }  // namespace mjtether
-
-#include "rov_controller.h"
 
 namespace mjtether {
 namespace {
@@ -559,8 +563,8 @@ TEST_F(VehicleTest, ControllerHoldsDepthWhileTheTetherGoesSlackToTaut) {
     controller.feed_forward_tether = feed_forward;
     const int body = mj_name2id(m, mjOBJ_BODY, "rov");
     const int k = FindTether(m, "umbilical");
-    const int a = mj_name2id(m, mjOBJ_SITE, "boat_reel"), b = mj_name2id(m, mjOBJ_SITE,
-                                                                          "tether_attach");
+    const int a = mj_name2id(m, mjOBJ_SITE, "boat_reel"),
+              b = mj_name2id(m, mjOBJ_SITE, "tether_attach");
     mj_forward(m, d);
     rov::Setpoint sp;
     sp.depth = d->xpos[3 * body + 2];
@@ -572,8 +576,7 @@ TEST_F(VehicleTest, ControllerHoldsDepthWhileTheTetherGoesSlackToTaut) {
       mj_step(m, d);
       EXPECT_FALSE(CheckDivergence(m, d));
       const double z = d->xpos[3 * body + 2];
-      const double ratio =
-          (Vec3(d->site_xpos + 3 * a) - Vec3(d->site_xpos + 3 * b)).norm() / 30;
+      const double ratio = (Vec3(d->site_xpos + 3 * a) - Vec3(d->site_xpos + 3 * b)).norm() / 30;
       const double tension = GetReactions(m, d, k).tension_b;
       if (d->time > 5) r.worst = std::max(r.worst, std::abs(z - sp.depth));
       if (d->time < 3) {
@@ -588,10 +591,11 @@ TEST_F(VehicleTest, ControllerHoldsDepthWhileTheTetherGoesSlackToTaut) {
     return r;
   };
   const Result with = run(true), without = run(false);
-  std::printf("depth error %.4f m (%.4f m without the tether feed-forward); tension %.2f N "
-              "early, %.2f N late; ends %.2f L then %.3f L apart\n",
-              with.worst, without.worst, with.tension_early, with.tension_late,
-              with.ratio_early, with.ratio_late);
+  std::printf(
+      "depth error %.4f m (%.4f m without the tether feed-forward); tension %.2f N "
+      "early, %.2f N late; ends %.2f L then %.3f L apart\n",
+      with.worst, without.worst, with.tension_early, with.tension_late, with.ratio_early,
+      with.ratio_late);
   EXPECT_LT(with.worst, 0.05);
   EXPECT_GT(without.worst, with.worst);
   EXPECT_LT(with.tension_early, 2);
