@@ -187,6 +187,20 @@ int Info(const std::string& path) {
               << "    explicit stable step " << t->ExplicitStableStep() << " s; "
               << t->SubstepsFor(m->opt.timestep) << " tether step(s) per MuJoCo step\n";
   }
+  // Vehicles: net buoyancy and how the added mass is split (README, Vehicles).
+  for (int v = 0; v < mjtether::VehicleCount(m); ++v) {
+    const mjtether::Vehicle* veh = mjtether::GetVehicle(m, v);
+    const int b = mjtether::VehicleBody(m, v);
+    const double mass = m->body_subtreemass[b];
+    const double net = veh->Buoyancy().norm() - mass * mju_norm3(m->opt.gravity);
+    std::cout << "  vehicle '" << mj_id2name(m, mjOBJ_BODY, b) << "': " << mass << " kg, net "
+              << (net >= 0 ? "buoyancy " : "weight ") << std::abs(net)
+              << " N; added mass in the armature " << veh->armature_translation()
+              << " kg (translation), explicit remainder up to "
+              << veh->explicit_added_mass().maxCoeff() << " kg (ratio "
+              << veh->explicit_added_mass().maxCoeff() / (mass + veh->armature_translation())
+              << " of m + a_iso; limit " << mjtether::Vehicle::kMaxExplicitRatio << ")\n";
+  }
   mjtether::Detach(m);
   mj_deleteModel(m);
   return 0;
