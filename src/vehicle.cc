@@ -50,7 +50,7 @@ Vec6 Vehicle::RelativeVelocity(const Eigen::Matrix3d& R, const Vec3& v, const Ve
   return nu_r;
 }
 
-// Fossen (2011) eq. 6.59 with diagonal D: D(nu_r) nu_r = (D_l + D_q |nu_r|) nu_r.
+// Fossen (2011), diagonal linear plus quadratic damping: D(nu_r) nu_r = (D_l + D_q |nu_r|) nu_r.
 Wrench Vehicle::Damping(const Vec6& nu_r) const {
   Vec6 tau = Vec6::Zero();
   if (linear_) tau -= p_.linear_damping.cwiseProduct(nu_r);
@@ -58,7 +58,7 @@ Wrench Vehicle::Damping(const Vec6& nu_r) const {
   return {tau.head<3>(), tau.tail<3>()};
 }
 
-// Fossen (2011) eq. 6.43, C_A(nu_r) nu_r for M_A = diag(A), minus what the armature carries
+// Fossen (2011), C_A(nu_r) nu_r for M_A = diag(A), minus what the armature carries
 // (a_iso dv/dt in the world frame = a_iso (dv_r/dt + w x v_r) in the body frame, and
 // A_w dw/dt).
 Wrench Vehicle::AddedMass(const Vec6& nu_r, const Vec3& dv_r) const {

@@ -1,6 +1,7 @@
 // Hydrodynamics of a rigid underwater vehicle in Fossen's body-frame model (T. I. Fossen,
-// "Handbook of Marine Craft Hydrodynamics and Motion Control", Wiley 2011, eq. 7.190 with
-// 6.43 and 6.59 for a diagonal added-mass matrix):
+// "Handbook of Marine Craft Hydrodynamics and Motion Control", Wiley 2011: the underwater
+// vehicle's equations of motion relative to a current, with the added-mass Coriolis matrix
+// C_A of a diagonal added-mass matrix and diagonal linear plus quadratic damping):
 //
 //   (M_RB + M_A) dnu/dt + C_RB(nu) nu + C_A(nu_r) nu_r + D(nu_r) nu_r + g(eta) = tau
 //

@@ -435,8 +435,8 @@ namespace {
 // pitch angle theta gives heave velocity w ~ U theta and the moment (A3 - A1) U^2 theta, which
 // overturns the vehicle against its righting moment W z_b theta once
 // U > U_c = sqrt(W z_b / (A3 - A1)) = 0.50 m/s for the BlueROV2 of Wu (2018) (Fossen 2011,
-// eq. 6.43; the classic instability of a body moving along its axis of least added mass). A
-// body-fixed surge force F = D_l U + D_q U^2 holds the speed U; the vehicle starts pitched
+// C_A of a diagonal M_A; the classic instability of a body moving along its axis of least added
+// mass). A body-fixed surge force F = D_l U + D_q U^2 holds the speed U; the vehicle starts pitched
 // 1 deg. At 0.7 U_c the pitch stays below 5 deg for 30 s; at 1.4 U_c it passes 30 deg; with
 // coriolis=0 (no C_A) 1.4 U_c stays below 5 deg too.
 TEST_F(VehicleTest, MunkMomentOverturnsPitchAboveTheCriticalSpeed) {
