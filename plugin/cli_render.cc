@@ -213,8 +213,7 @@ int Render(const RenderCliOptions& opt) {
     frame_ms.push_back(
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     if (!opt.video.empty() && !ffmpeg.Write(rgb.data(), rgb.size())) {
-      std::cerr << (progress ? "\n" : "") << "mjtether: ffmpeg stopped reading frames\n";
-      status = 4;
+      status = 4;  // ffmpeg stopped reading: its exit status is reported below
       break;
     }
     if (still) {
@@ -239,11 +238,13 @@ int Render(const RenderCliOptions& opt) {
 
   if (!opt.video.empty()) {
     const int rc = ffmpeg.Close();
-    if (rc != 0 && status == 0) {
+    if (rc != 0 && (status == 0 || status == 4)) {
       std::cerr << "mjtether: ffmpeg failed (exit status " << rc
                 << (rc == 127 ? ": ffmpeg not found on PATH" : "") << ") writing " << opt.video
                 << "\n";
       status = 4;
+    } else if (status == 4) {
+      std::cerr << "mjtether: ffmpeg stopped reading frames for " << opt.video << "\n";
     }
   }
   if (status == 0) {
