@@ -50,6 +50,7 @@ struct ModelVehicles {
   std::vector<AttachedVehicle> vehicles;
   std::vector<AttachedMotion> motions;
   std::vector<AttachedSchedule> schedules;
+  int nuserdata = 0;  // m->nuserdata after Attach, to catch a stale registration
 };
 
 std::shared_mutex g_mutex;
@@ -58,7 +59,9 @@ std::unordered_map<const mjModel*, std::unique_ptr<ModelVehicles>> g_models;
 const ModelVehicles* Lookup(const mjModel* m) {
   std::shared_lock<std::shared_mutex> lock(g_mutex);
   auto it = g_models.find(m);
-  return it == g_models.end() ? nullptr : it->second.get();
+  // A model deleted without Detach and another allocated at the same address: ignore.
+  if (it == g_models.end() || it->second->nuserdata != m->nuserdata) return nullptr;
+  return it->second.get();
 }
 
 using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
@@ -142,6 +145,7 @@ bool AttachVehicles(mjModel* m, const std::string& source, const Environment& en
     av.offset = *offset;
     *offset += kVehicleBlock;
   }
+  set->nuserdata = *offset;  // what Attach sets m->nuserdata to
   // Added mass into the free joints' armature: world-frame translation dofs take the isotropic
   // part, body-frame rotation dofs the rotational diagonal (see vehicle.h).
   for (const AttachedVehicle& av : set->vehicles) {
