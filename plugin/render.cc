@@ -132,9 +132,19 @@ void FinishDecor(mjvGeom* g, mjvScene* scn) {
   ++scn->ngeom;
 }
 
-// Radius [m] a tether is drawn with: its own, or thick enough to be seen at the scene's scale.
-double DrawnRadius(const Tether& t) {
-  return std::max(0.5 * t.params().diameter, t.params().length / 200.0);
+// Radius [m] a tether is drawn with: its own, or thick enough to be seen from the camera's
+// distance D [m] (about 1/160 of the view's height).
+double DrawnRadius(const Tether& t, double D) {
+  return std::max(0.5 * t.params().diameter, D / 250.0);
+}
+
+// Radius [m] of the sphere around body b's origin that holds its geoms.
+double BodySize(const mjModel* m, int b) {
+  double r = 0;
+  for (int g = 0; g < m->ngeom; ++g) {
+    if (m->geom_bodyid[g] == b) r = std::max(r, mju_norm3(m->geom_pos + 3 * g) + m->geom_rbound[g]);
+  }
+  return r;
 }
 
 }  // namespace
@@ -243,8 +253,8 @@ std::unique_ptr<Renderer> Renderer::Create(mjModel* m, const RenderOptions& opti
 
   // Camera.
   const std::string& c = o.camera;
+  r->cam_.type = mjCAMERA_FREE;
   if (c == "follow") {
-    r->cam_.type = mjCAMERA_FREE;
   } else if (c.rfind("track:", 0) == 0) {
     const std::string body = c.substr(6);
     const int b = mj_name2id(m, mjOBJ_BODY, body.c_str());
@@ -252,8 +262,8 @@ std::unique_ptr<Renderer> Renderer::Create(mjModel* m, const RenderOptions& opti
       *error = "--camera " + c + ": no body named '" + body + "' in the model";
       return nullptr;
     }
-    r->cam_.type = mjCAMERA_TRACKING;
-    r->cam_.trackbodyid = b;
+    r->track_body_ = b;
+    if (o.distance <= 0) r->follow_distance_ = std::max(1.0, 15 * BodySize(m, b));
     if (o.vehicle.empty()) r->vehicle_ = b;
   } else {
     const int id = mj_name2id(m, mjOBJ_CAMERA, c.c_str());
@@ -341,9 +351,15 @@ Renderer::~Renderer() {
 }
 
 // The follow camera looks at the centre of the box that bounds the tethers' nodes and the
-// vehicle: it moves with the vehicle and keeps the whole tether in view.
+// vehicle: it moves with the vehicle and keeps the whole tether in view. The track camera looks
+// at its body's origin. Both are set from the state alone, so a frame does not depend on the
+// frames before it (MuJoCo's own tracking camera filters its motion from frame to frame).
 void Renderer::PlaceCamera(const mjModel* m, const mjData* d) {
   if (cam_.type != mjCAMERA_FREE) return;
+  if (track_body_ >= 0) {
+    for (int i = 0; i < 3; ++i) cam_.lookat[i] = d->xpos[3 * track_body_ + i];
+    return;
+  }
   Vec3 lo = Vec3::Constant(mjMAXVAL), hi = Vec3::Constant(-mjMAXVAL);
   auto add = [&](const double* p) {
     lo = lo.cwiseMin(Vec3(p));
@@ -380,7 +396,7 @@ void Renderer::Decorate(const mjModel* m, const mjData* d) {
       if (!x) continue;
       T.resize(t.segments());
       GetTensions(m, d, k, T.data());
-      const double radius = DrawnRadius(t);
+      const double radius = DrawnRadius(t, D);
       for (int j = 0; j < t.segments(); ++j) {
         const double* a = x + 3 * j;
         const double* b = x + 3 * j + 3;

@@ -35,10 +35,12 @@ struct RenderOptions {
   int samples = 4;   // multisampling (MSAA) samples, 0 to 16; 0 halves the software cost
   // "follow" (default): a free camera looking at the centre of the box bounding the tethers
   // and the vehicle, from the side of the current (across it), 12 degrees down, at a fixed
-  // distance; "track:BODY": MuJoCo's tracking camera on BODY, same direction and distance;
-  // otherwise the name of a <camera> in the model.
+  // distance; "track:BODY": looks at BODY's origin from the same direction; otherwise the name
+  // of a <camera> in the model.
   std::string camera = "follow";
-  double distance = 0;       // [m] of the follow and track cameras; <= 0: 1.25 x the longest tether
+  // [m] of the follow and track cameras; <= 0: 1.25 x the longest tether (follow), 15 x the
+  // radius of the body's geoms, at least 1 m (track).
+  double distance = 0;
   double tension_max = 0;    // [N] top of the colour scale; <= 0: 1 N
   std::string vehicle;       // body whose depth the HUD shows; empty: found (see Vehicle)
   bool hud = true;           // draw the HUD and the colour scale
@@ -107,7 +109,8 @@ class Renderer {
   mjvOption vopt_;
   bool scene_made_ = false, context_made_ = false;
   int vehicle_ = -1;             // body whose depth the HUD shows
-  double follow_distance_ = 10;  // [m] of the follow camera
+  double follow_distance_ = 10;  // [m] of the follow and track cameras
+  int track_body_ = -1;          // body the track camera looks at, or -1
   double follow_azimuth_ = 90;   // [deg]
   int seabed_geom_ = -1;         // a model plane at the seabed height, or -1
 };

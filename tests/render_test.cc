@@ -67,10 +67,12 @@ class RenderTest : public ::testing::Test {
 };
 
 // Pixel (column, row from the bottom) where world point p projects through the scene's camera,
-// as mjr_render sets up OpenGL: a look-at view from pos along forward with up, and a frustum
-// [center -/+ half width] x [bottom, top] at the near plane, its width from the aspect ratio.
+// as mjr_render sets up OpenGL for a mono image: the average of the two eyes' cameras (each is
+// offset by half the inter-pupillary distance), a look-at view from pos along forward with up,
+// and a frustum [center -/+ half width] x [bottom, top] at the near plane, its width from the
+// aspect ratio.
 std::array<double, 2> Project(const mjvScene& scn, int W, int H, const double* p) {
-  const mjvGLCamera& c = scn.camera[0];
+  const mjvGLCamera c = mjv_averageCamera(&scn.camera[0], &scn.camera[1]);
   double v[3], right[3];
   for (int i = 0; i < 3; ++i) v[i] = p[i] - c.pos[i];
   const double f[3] = {c.forward[0], c.forward[1], c.forward[2]};
@@ -183,6 +185,51 @@ TEST_F(RenderTest, TetherPixelsAppearWhereTheNodesProjectInTheirTensionColour) {
     }
   }
   EXPECT_EQ(far_changed, 0);
+}
+
+// The follow camera keeps every node of the tether and the vehicle in the picture through the
+// default scene's manoeuvre (snap included); the track camera puts its body at the centre.
+TEST(RenderCamera, FollowKeepsTheWholeTetherInViewAndTrackCentresTheBody) {
+  std::string error;
+  mjModel* m = LoadModel(std::string(MJTETHER_MODELS_DIR) + "/rov_tether.xml", &error);
+  ASSERT_NE(m, nullptr) << error;
+  mjData* d = mj_makeData(m);
+  const int W = 160, H = 90;
+  RenderOptions opt;
+  opt.width = W;
+  opt.height = H;
+  opt.samples = 0;
+  opt.hud = false;
+  std::unique_ptr<Renderer> follow = Renderer::Create(m, opt, &error);
+  ASSERT_NE(follow, nullptr) << error;
+  opt.camera = "track:rov";
+  std::unique_ptr<Renderer> track = Renderer::Create(m, opt, &error);
+  ASSERT_NE(track, nullptr) << error;
+  const int rov = mj_name2id(m, mjOBJ_BODY, "rov");
+  std::vector<unsigned char> rgb(3 * W * H);
+  const int k = FindTether(m, "umbilical");
+  for (int frame = 0; frame <= 10; ++frame) {
+    while (d->time < 2.0 * frame - 1e-9) Step(m, d);
+    mj_forward(m, d);
+    follow->Render(m, d, rgb.data());
+    const double* x = NodePositions(m, d, k);
+    for (int i = 0; i < GetTether(m, k)->nodes(); ++i) {
+      const std::array<double, 2> p = Project(follow->scene(), W, H, x + 3 * i);
+      EXPECT_TRUE(p[0] >= 0 && p[0] <= W && p[1] >= 0 && p[1] <= H)
+          << "t = " << d->time << " node " << i << " at (" << p[0] << ", " << p[1] << ")";
+    }
+    // The body's origin projects to the centre to within a thousandth of the width (the
+    // camera's data are floats).
+    track->Render(m, d, rgb.data());
+    const std::array<double, 2> c = Project(track->scene(), W, H, d->xpos + 3 * rov);
+    EXPECT_NEAR(c[0], W / 2.0, 1e-3 * W) << "t = " << d->time;
+    EXPECT_NEAR(c[1], H / 2.0, 1e-3 * W) << "t = " << d->time;
+  }
+  follow.reset();
+  track.reset();
+  mj_deleteData(d);
+  Detach(m);
+  mj_deleteModel(m);
 }
 
 TEST_F(RenderTest, HudDrawsTextInTheTopLeftCorner) {
