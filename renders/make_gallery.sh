@@ -5,6 +5,8 @@
 set -euo pipefail
 M=${MJTETHER:-./build/mjtether}
 R=renders
+# Stills directories are remade, so that no still of an older run stays behind.
+find "$R" -mindepth 1 -maxdepth 1 -type d -exec rm -rf {} +
 
 # Default scene: the ROV drives down-current on its thrusters until the tether snaps taut.
 $M render models/rov_tether.xml --duration 20 --fps 15 --size 640x360 \
@@ -31,6 +33,10 @@ $M plot models/manoeuvre_station_keeping.xml --duration 40 \
 $M render models/manoeuvre_turn_wrap.xml --duration 30 --fps 10 --speedup 1.5 \
   --size 640x360 --video $R/manoeuvre_turn_wrap.mp4 --png-every 10 $R/manoeuvre_turn_wrap
 $M plot models/manoeuvre_turn_wrap.xml --duration 30 --out $R/manoeuvre_turn_wrap_plot.png
+# The same turn from close by: the camera looks at the vehicle.
+$M render models/manoeuvre_turn_wrap.xml --duration 30 --fps 10 --speedup 1.5 --size 640x360 \
+  --camera track:rov --video $R/manoeuvre_turn_wrap_closeup.mp4 \
+  --png-every 15 $R/manoeuvre_turn_wrap_closeup
 
 # BlueROV2 Heavy hanging from a heaving boat.
 $M render models/bluerov2_heavy.xml --duration 20 --fps 10 --size 640x360 \
