@@ -253,9 +253,8 @@ std::unique_ptr<Renderer> Renderer::Create(mjModel* m, const RenderOptions& opti
 
   // Camera.
   const std::string& c = o.camera;
-  r->cam_.type = mjCAMERA_FREE;
-  if (c == "follow") {
-  } else if (c.rfind("track:", 0) == 0) {
+  r->cam_.type = mjCAMERA_FREE;  // follow and track: placed from the state at each frame
+  if (c.rfind("track:", 0) == 0) {
     const std::string body = c.substr(6);
     const int b = mj_name2id(m, mjOBJ_BODY, body.c_str());
     if (b < 0) {
@@ -265,7 +264,7 @@ std::unique_ptr<Renderer> Renderer::Create(mjModel* m, const RenderOptions& opti
     r->track_body_ = b;
     if (o.distance <= 0) r->follow_distance_ = std::max(1.0, 15 * BodySize(m, b));
     if (o.vehicle.empty()) r->vehicle_ = b;
-  } else {
+  } else if (c != "follow") {
     const int id = mj_name2id(m, mjOBJ_CAMERA, c.c_str());
     if (id < 0) {
       *error =
