@@ -287,8 +287,8 @@ std::function<int()> SetupRender(CLI::App* sub) {
                   "rounded up to 1, 2, 3, 4, 5, 6 or 8 x 10^k")
       ->check(CLI::Range(0.0, 1e12));
   sub->add_option("--distance", opt->distance,
-                  "camera distance for follow and track:BODY [m] (default 1.25 x the longest "
-                  "tether)")
+                  "camera distance for follow and track:BODY [m] (default: 1.25 x the longest "
+                  "tether for follow, 15 x the body's radius for track)")
       ->check(CLI::Range(0.0, 1e6));
   sub->add_option("--speedup", opt->speedup,
                   "the video plays this many times faster than real time (its frame rate is "
