@@ -204,7 +204,7 @@ int Render(const RenderCliOptions& opt) {
     }
     if (status) break;
     // Still j at frame round(j * png_every * fps).
-    const bool still = png_every > 0 && k == std::llround(next_png * png_every * opt.fps);
+    const bool still = png_every > 0 && k >= std::llround(next_png * png_every * opt.fps);
     if (opt.video.empty() && !still) continue;
 
     mj_forward(m, d);  // the tether at d->time
@@ -225,7 +225,9 @@ int Render(const RenderCliOptions& opt) {
         status = 2;
         break;
       }
-      ++next_png;
+      // Next still: the first one due after this frame (several may fall on one frame when
+      // the interval is shorter than a frame).
+      while (std::llround(next_png * png_every * opt.fps) <= k) ++next_png;
       ++npng;
     }
     if (progress) {
