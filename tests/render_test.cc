@@ -397,6 +397,20 @@ TEST_F(RenderCli, VideoHasTheFrameCountAndSizeAsked) {
   EXPECT_EQ(stills, 2);
 }
 
+// Stills are taken on the nearest frame: an interval shorter than a frame gives one still per
+// frame (0, 0.1, 0.2 s at 10 fps), not one still and then none.
+TEST_F(RenderCli, StillsShorterThanAFrameFallOnEveryFrame) {
+  int status = 0;
+  const std::string out =
+      Shell(cli_ + " render " + model_ + " --duration 0.3 --fps 10 --size 64x48 --samples 0" +
+                " --png-every 0.01 " + (dir_ / "s").string() + " 2>&1",
+            &status);
+  ASSERT_EQ(status, 0) << out;
+  for (const char* name : {"t_00000.000.png", "t_00000.100.png", "t_00000.200.png"}) {
+    EXPECT_EQ(PngSize((dir_ / "s" / name).string()), (std::array<int, 2>{64, 48})) << name;
+  }
+}
+
 TEST_F(RenderCli, FfmpegFailureIsExitCode4AndBadSizeIs2) {
   int status = 0;
   const std::string out = Shell(cli_ + " render " + model_ +
