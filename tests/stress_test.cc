@@ -189,7 +189,11 @@ LoopResult RunLoop(Integrator integrator, double EI) {
 // 0.6 m, not > 2.5 m); as they shorten, the bending stiffness ~ EI/(L0 l^2) outgrows any fixed
 // step and the energy rises after the ends stop (measured: implicit +2.4 J, explicit +0.8 J;
 // +64 J and +960 J at EI = 0.5 and 2; still +7 J with 0.1 ms implicit steps). Enable once
-// slack segments resist shortening when EI > 0.
+// slack segments resist shortening when EI > 0. Tried outside the tree: letting segments carry
+// compression EA eps when bending is on (implicit: its EA/L0 t t^T block, no negative
+// geometric term) gives min segment 1.000 L0, length 10.000 m, no energy rise, kinetic
+// energy 0.17% of its peak, but a buckled wave of extent 1.0 m rather than one loop (drag
+// sets the wavelength), so the extent and kinetic thresholds here would need review too.
 TEST_P(Integrators, DISABLED_ZeroTensionLoopWithBendingIsSmooth) {
   const LoopResult r = RunLoop(GetParam(), 0.05);
   std::printf(
