@@ -67,7 +67,7 @@ set xlabel "CPU time per simulated second [ms]"
 set autoscale y
 do for [sc in "catenary swing snap slack"] {
   set title sc eq "catenary" ? "static catenary, 100 m, settled after 40 s" : \
-            sc eq "swing" ? "swing: dry 10 m chain released horizontal, 5 s" : \
+            sc eq "swing" ? "swing: dry 10 m chain released straight at 30° from hanging, 5 s" : \
             sc eq "snap" ? "snap: 20 m line jerked from 0.9 L to 1.005 L in 0.5 s, 3 s" : \
             "slack: 40 m ROV tether, EI 0.5, current 0.3 m/s, end circling, 20 s"
   plot for [i=1:3] file(sc."_".word(series, i)) using 1:2 with points pt ptype(i) \

@@ -11,7 +11,8 @@
 //             MuJoCo <composite type="rope"> chain.
 //   catenary  static elastic catenary settling from the inextensible shape; reference: Irvine's
 //             closed form (tests/catenary_reference.h).
-//   swing     a dry chain released horizontal from a fixed end (pendulum of a free tether).
+//   swing     a dry chain released straight at 30 degrees from hanging (pendulum of a free
+//             tether).
 //   snap      a slack line jerked taut: end B moves 0.9 L -> 1.005 L in 0.5 s.
 //   slack     slack ROV tether with bending and a current, end B circling.
 //
@@ -74,14 +75,24 @@ struct Scene {
   double error_from = 0;                 // [s] samples before this are not in the error
   std::vector<int> segments;             // N of the sweep
   int reference_segments = 0;            // finest N (reference)
+  double start_angle = -1;  // [rad] >= 0: free end starts straight, this far from hanging, at rest
   bool static_reference = false;         // error of the final tension against the closed form
   double static_tension = 0;             // [N] closed-form end tension at B
 };
+
+struct Scene;
+double s_len(const Scene& s);
 
 EndState Fixed(Vec3 p) {
   EndState e;
   e.pos = p;
   return e;
+}
+
+// Unstretched length from the declaration ("length=...").
+double s_len(const Scene& s) {
+  const size_t at = s.declaration.find("length=");
+  return std::stod(s.declaration.substr(at + 7));
 }
 
 Scene LineScene() {
@@ -136,6 +147,7 @@ Scene SwingScene() {
     e.axis = Vec3(1, 0, 0);
     return e;
   };
+  s.start_angle = kPi / 6;
   s.duration = 5;
   s.sample = 0.02;
   s.segments = {10, 20, 40, 80};
@@ -286,6 +298,13 @@ Run RunEngine(const Scene& s, int N, const std::string& integrator, double outer
   const Stamp start = Now();
   Ends from = EndsAt(s, 0);
   t->InitialShape(from, x.data(), v.data());
+  if (s.start_angle >= 0) {
+    const Vec3 dir(std::sin(s.start_angle), 0, -std::cos(s.start_angle));
+    for (int i = 0; i < t->nodes(); ++i) {
+      const Vec3 p = from.a.pos + dir * (s_len(s) * i / N);
+      for (int k = 0; k < 3; ++k) x[3 * i + k] = p[k];
+    }
+  }
   double sink = 0;
   for (long k = 0; k < steps; ++k) {
     if (k % every == 0) {
