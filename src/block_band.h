@@ -5,7 +5,8 @@
 // computations and branches, which is what made the scalar band version (band_cholesky.h)
 // slow at half-bandwidth 8.
 //
-// Storage: 27 doubles per block row, column-major 3x3 blocks: D(i) = A(i,i) (full, symmetric),
+// Storage: 27 doubles per block row, column-major 3x3 blocks: D(i) = A(i,i) (symmetric; only
+// its lower triangle is read),
 // L1(i) = A(i,i-1), L2(i) = A(i,i-2). Factor() overwrites them with the block Cholesky factor
 // (A = L L^T): D(i) holds the inverse of the lower-triangular diagonal block, L1, L2 the
 // off-diagonal blocks of L.
@@ -35,35 +36,41 @@ class BlockBand {
   // positive (not positive definite), or -1 on success.
   int Factor() {
     for (int i = 0; i < n_; ++i) {
-      Block d = D(i), l1 = L1(i), l2 = L2(i);
+      double* d = a_ + 27 * i;
+      double* l1 = d + 9;
+      double* l2 = d + 18;
       // Off-diagonal blocks of L in this row: L(i,k) = (A(i,k) - sum_j L(i,j) L(k,j)^T) Lkk^-T.
       if (bands_ == 2 && i >= 2) {
-        l2 = l2 * ConstBlock(a_ + 27 * (i - 2)).transpose();  // D(i-2) holds L(i-2,i-2)^-1
+        TimesLowerTransposed(l2, a_ + 27 * (i - 2));  // D(i-2) holds L(i-2,i-2)^-1
       }
       if (i >= 1) {
-        if (bands_ == 2 && i >= 2)
-          l1.noalias() -= l2 * ConstBlock(a_ + 27 * (i - 1) + 9).transpose();
-        l1 = l1 * ConstBlock(a_ + 27 * (i - 1)).transpose();
-        d.noalias() -= l1 * l1.transpose();
-        if (bands_ == 2 && i >= 2) d.noalias() -= l2 * l2.transpose();
+        if (bands_ == 2 && i >= 2) {
+          ConstBlock L2(l2), P(a_ + 27 * (i - 1) + 9);  // L(i-1,i-2)
+          Block(l1).noalias() -= L2 * P.transpose();
+        }
+        TimesLowerTransposed(l1, a_ + 27 * (i - 1));
+        SubtractLowerGram(d, l1);
+        if (bands_ == 2 && i >= 2) SubtractLowerGram(d, l2);
       }
-      // 3x3 Cholesky of d, then its inverse (lower triangular) in place.
-      const double p0 = d(0, 0);
+      // 3x3 Cholesky of d (lower triangle), then its inverse (lower triangular) in place.
+      // Column-major: d[r + 3 c] = d(r, c).
+      const double p0 = d[0];
       if (!(p0 > 0)) return i;
-      const double l00 = std::sqrt(p0);
-      const double l10 = d(1, 0) / l00, l20 = d(2, 0) / l00;
-      const double p1 = d(1, 1) - l10 * l10;
+      const double i00 = 1 / std::sqrt(p0);
+      const double l10 = d[1] * i00, l20 = d[2] * i00;
+      const double p1 = d[4] - l10 * l10;
       if (!(p1 > 0)) return i;
-      const double l11 = std::sqrt(p1);
-      const double l21 = (d(2, 1) - l20 * l10) / l11;
-      const double p2 = d(2, 2) - l20 * l20 - l21 * l21;
+      const double i11 = 1 / std::sqrt(p1);
+      const double l21 = (d[5] - l20 * l10) * i11;
+      const double p2 = d[8] - l20 * l20 - l21 * l21;
       if (!(p2 > 0)) return i;
-      const double l22 = std::sqrt(p2);
-      const double i00 = 1 / l00, i11 = 1 / l11, i22 = 1 / l22;
+      const double i22 = 1 / std::sqrt(p2);
       const double i10 = -l10 * i00 * i11;
       const double i21 = -l21 * i11 * i22;
       const double i20 = -(l20 * i00 + l21 * i10) * i22;
-      d << i00, 0, 0, i10, i11, 0, i20, i21, i22;
+      d[0] = i00, d[1] = i10, d[2] = i20;
+      d[3] = 0, d[4] = i11, d[5] = i21;
+      d[6] = 0, d[7] = 0, d[8] = i22;
     }
     return -1;
   }
@@ -89,6 +96,25 @@ class BlockBand {
   }
 
  private:
+  // x = x T^T in place, T lower triangular (column-major 3x3): column c of the product takes
+  // columns 0..c of x, so columns are formed from the last to the first.
+  static void TimesLowerTransposed(double* x, const double* t) {
+    for (int r = 0; r < 3; ++r) {
+      const double x0 = x[r], x1 = x[r + 3], x2 = x[r + 6];
+      x[r + 6] = x0 * t[2] + x1 * t[5] + x2 * t[8];
+      x[r + 3] = x0 * t[1] + x1 * t[4];
+      x[r] = x0 * t[0];
+    }
+  }
+  // The lower triangle of d -= x x^T (the Cholesky step reads only the lower triangle).
+  static void SubtractLowerGram(double* d, const double* x) {
+    for (int c = 0; c < 3; ++c) {
+      for (int r = c; r < 3; ++r) {
+        d[r + 3 * c] -= x[r] * x[c] + x[r + 3] * x[c + 3] + x[r + 6] * x[c + 6];
+      }
+    }
+  }
+
   double* a_;
   int n_, bands_;
 };

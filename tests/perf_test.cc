@@ -209,9 +209,10 @@ namespace {
 // weight, 490 N (a point mass released horizontal peaks at 3 mg; the whip of the free end adds
 // to that, and the bound leaves room for it but not for the blow-up).
 TEST(Implicit2, SwingAtALargeStepDoesNotDiverge) {
-  const Tether t = Make("ends=a,free length=10 segments=80 diameter=0.01 mass_per_length=0.5 "
-                        "EA=1e5 damping=5 integrator=implicit2",
-                        "");
+  const Tether t = Make(
+      "ends=a,free length=10 segments=80 diameter=0.01 mass_per_length=0.5 "
+      "EA=1e5 damping=5 integrator=implicit2",
+      "");
   Ends ends;
   ends.a.axis = Vec3(1, 0, 0);  // gravity pulls the free end down, so the chain starts vertical
   std::vector<double> x(3 * t.nodes()), v(3 * t.nodes()), work(t.WorkspaceSize());

@@ -76,8 +76,8 @@ struct Scene {
   std::vector<int> segments;             // N of the sweep
   int reference_segments = 0;            // finest N (reference)
   double start_angle = -1;  // [rad] >= 0: free end starts straight, this far from hanging, at rest
-  bool static_reference = false;         // error of the final tension against the closed form
-  double static_tension = 0;             // [N] closed-form end tension at B
+  bool static_reference = false;  // error of the final tension against the closed form
+  double static_tension = 0;      // [N] closed-form end tension at B
 };
 
 struct Scene;
@@ -216,9 +216,9 @@ struct Run {
   std::vector<double> T;             // end tension at each sample [N]
   std::vector<std::vector<Vec3>> x;  // nodes at each sample
   double err_T = NAN, err_T_time = NAN, err_x = NAN;
-  double duration = 0;        // [s] simulated
-  double mean_T = 0;          // [N] mean reference tension over the error window
-  bool pareto = false;        // on the scene's front (no run cheaper and more accurate)
+  double duration = 0;         // [s] simulated
+  double mean_T = 0;           // [N] mean reference tension over the error window
+  bool pareto = false;         // on the scene's front (no run cheaper and more accurate)
   bool pareto_series = false;  // on the front of its own path and integrator
   double ms() const { return 1e3 * cpu / duration; }  // CPU ms per simulated second
   std::string series() const { return path == "engine" ? integrator : path + "_" + integrator; }
@@ -475,8 +475,8 @@ Run RunRope(const Scene& s, int links, double h) {
   mj_forward(m, d);
   if (std::getenv("ACCURACY_COST_DUMP")) {
     const int last = m->nbody - 1;
-    std::fprintf(stderr, "rope: last body %g %g %g, nefc %d, efc_pos %g %g %g\n",
-                 d->xpos[3 * last], d->xpos[3 * last + 1], d->xpos[3 * last + 2], d->nefc,
+    std::fprintf(stderr, "rope: last body %g %g %g, nefc %d, efc_pos %g %g %g\n", d->xpos[3 * last],
+                 d->xpos[3 * last + 1], d->xpos[3 * last + 2], d->nefc,
                  d->nefc > 0 ? d->efc_pos[0] : 0.0, d->nefc > 1 ? d->efc_pos[1] : 0.0,
                  d->nefc > 2 ? d->efc_pos[2] : 0.0);
   }
@@ -566,8 +566,7 @@ Run Reference(const Scene& s, int N, bool finest) {
   for (size_t k = 0; k < r.x.size(); ++k) {
     for (size_t i = 0; i < r.x[k].size(); ++i) r.x[k][i] = 2 * b.x[k][i] - a.x[k][i];
   }
-  std::fprintf(stderr,
-               "  reference %s N=%d: h=%.3g s, Richardson correction RMS %.3g N (%.1f s)\n",
+  std::fprintf(stderr, "  reference %s N=%d: h=%.3g s, Richardson correction RMS %.3g N (%.1f s)\n",
                s.name.c_str(), N, h / 8, RmsDiff(a.T, b.T, 0), a.wall + b.wall);
   return r;
 }
@@ -582,8 +581,8 @@ void MarkPareto(std::vector<Run>* runs) {
     r.pareto = r.pareto_series = true;
     for (const Run& o : *runs) {
       if (&o == &r || o.scene != r.scene || !o.ok || !std::isfinite(o.err_T)) continue;
-      const bool better = o.ms() <= r.ms() && o.err_T <= r.err_T &&
-                          (o.ms() < r.ms() || o.err_T < r.err_T);
+      const bool better =
+          o.ms() <= r.ms() && o.err_T <= r.err_T && (o.ms() < r.ms() || o.err_T < r.err_T);
       if (better) {
         r.pareto = false;
         if (o.series() == r.series()) r.pareto_series = false;
@@ -602,9 +601,9 @@ void Write(const std::string& dir, std::vector<Run>* runs) {
                "err_T_N,err_T_time_N,err_x_m,mean_T_N,ok,pareto,pareto_series\n");
   for (const Run& r : *runs) {
     std::fprintf(csv, "%s,%s,%s,%d,%.6g,%.6g,%.4g,%.4g,%.4g,%.4g,%.4g,%.6g,%d,%d,%d\n",
-                 r.scene.c_str(), r.path.c_str(), r.integrator.c_str(), r.segments, r.step,
-                 r.outer, r.ms(), 1e3 * r.wall / r.duration, r.err_T, r.err_T_time, r.err_x,
-                 r.mean_T, r.ok ? 1 : 0, r.pareto ? 1 : 0, r.pareto_series ? 1 : 0);
+                 r.scene.c_str(), r.path.c_str(), r.integrator.c_str(), r.segments, r.step, r.outer,
+                 r.ms(), 1e3 * r.wall / r.duration, r.err_T, r.err_T_time, r.err_x, r.mean_T,
+                 r.ok ? 1 : 0, r.pareto ? 1 : 0, r.pareto_series ? 1 : 0);
   }
   std::fclose(csv);
 
@@ -640,7 +639,6 @@ struct Options {
   bool rope_only = false;  // debugging: only the composite rope runs
   std::vector<double> steps = {0.05, 0.02, 0.01, 0.005, 0.002, 0.001};  // [s] implicit steps
 };
-
 
 }  // namespace
 }  // namespace mjtether

@@ -13,11 +13,11 @@
 //                 within noise, which shows that an effect that is off costs nothing
 // Each iteration is Advance over one tether step (the explicit scheme at 90% of its stable
 // step, the implicit ones at 2 ms) plus the end reactions, as in the MuJoCo callback.
-#include <string>
-#include <vector>
-
 #include <benchmark/benchmark.h>
 #include <mujoco/mujoco.h>
+
+#include <string>
+#include <vector>
 
 #include "declaration.h"
 #include "tether.h"
@@ -90,9 +90,9 @@ void TetherStep(benchmark::State& state, std::string declaration, bool wet) {
     sink += t->Reactions(x.data(), v.data(), ends, work.data()).tension_b;
   }
   benchmark::DoNotOptimize(sink);
-  state.counters["per_node_step"] = benchmark::Counter(
-      static_cast<double>(state.iterations()) * (N + 1),
-      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["per_node_step"] =
+      benchmark::Counter(static_cast<double>(state.iterations()) * (N + 1),
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
 // MuJoCo's own step of one free body: the floor under any callback.
@@ -123,8 +123,8 @@ void FreeBody(benchmark::State& state) {
 
 int main(int argc, char** argv) {
   using namespace mjtether;
-  const std::vector<std::string> effects = {"damping", "bending", "weight", "buoyancy", "drag",
-                                            "added_mass", "current", "seabed"};
+  const std::vector<std::string> effects = {"damping", "bending",    "weight",  "buoyancy",
+                                            "drag",    "added_mass", "current", "seabed"};
   for (const char* integrator : {"explicit", "implicit", "implicit2"}) {
     const std::string scheme = std::string(" integrator=") + integrator;
     std::vector<std::pair<std::string, std::pair<std::string, bool>>> cases;
