@@ -1,8 +1,13 @@
 // What accuracy costs in time: runs reference scenes across integrators, segment counts and
 // time steps, measures the error of end tension and node positions against a converged
-// reference and the wall time per simulated second, and writes a CSV and a markdown table.
+// reference and the CPU (and wall) time per simulated second, and writes accuracy_cost.csv and
+// accuracy_cost.md into DIR. tools/accuracy_cost.sh runs it and draws the charts.
 //
-//   accuracy_cost [--quick] [--scenes line,catenary,...] [--out DIR]
+//   accuracy_cost [--quick] [--scenes line,catenary,...] [--steps 0.05,0.01] [--out DIR]
+//
+// --quick: 10 and 20 segments against 40 (seconds); --steps: the implicit steps [s].
+// Debugging aids: --rope-only (only the composite rope runs, with a summary), and the
+// environment variable ACCURACY_COST_DUMP=DIR (tension series of every run, rope MJCF).
 //
 // Scenes (see Scenes() below):
 //   line      the fixed comparison scene: 100 m line, anchor (0,0,-150), fairlead from
@@ -16,12 +21,12 @@
 //   snap      a slack line jerked taut: end B moves 0.9 L -> 1.005 L in 0.5 s.
 //   slack     slack ROV tether with bending and a current, end B circling.
 //
-// Reference: for each scene, the finest segment count (Nref), integrated with the explicit
-// scheme at a quarter and an eighth of its stable step and extrapolated (Richardson, order 1);
-// with the same procedure at each N, a reference of the same N separates the time error from
-// the space error. Error columns: `err_T` RMS over the samples of the end tension against the
-// finest reference, `err_T_time` against the same-N reference, `err_x` RMS over samples of the
-// largest node distance to the reference's node at the same arc length.
+// Reference: for each scene, the finest segment count (Nref) integrated with the explicit
+// scheme at half its stable step; at each N of the sweep, the explicit scheme at a quarter and
+// an eighth of its stable step, Richardson-extrapolated (order 1), separates the time error
+// from the space error. Error columns: `err_T` RMS over the samples (after `error_from`) of the
+// end tension against the finest reference, `err_T_time` against the same-N reference, `err_x`
+// RMS over samples of the largest node distance to the reference's node at the same arc length.
 #include <mujoco/mujoco.h>
 
 #include <algorithm>
