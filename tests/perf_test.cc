@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "block_band.h"
@@ -141,12 +142,12 @@ TEST(Reactions, WindowsEqualTheFullEvaluationBitForBit) {
 // numerical damping of the first axial mode is comparable to the tether's own, see README).
 // Bounds: > 3 for implicit2, [1.2, 2.2] for backward Euler; and implicit2 at least 10 times more
 // accurate at 1 ms (measured: 350 times).
-std::vector<double> LineTension(const std::string& integrator, double h) {
-  const Tether t = Make(
-      "ends=a,b length=100 segments=10 diameter=0.025 mass_per_length=1 "
-      "EA=1e6 damping=1000 Cdn=1.2 Can=1 Cdt=0.008 integrator=" +
-          integrator,
-      "density=1025");
+std::vector<double> LineTension(const std::string& integrator, double h, int segments = 10) {
+  const Tether t = Make("ends=a,b length=100 segments=" + std::to_string(segments) +
+                            " diameter=0.025 mass_per_length=1 "
+                            "EA=1e6 damping=1000 Cdn=1.2 Can=1 Cdt=0.008 integrator=" +
+                            integrator,
+                        "density=1025");
   auto at = [](double time) {
     Ends e;
     e.a.pos = Vec3(0, 0, -150);
@@ -226,6 +227,29 @@ TEST(Implicit2, SwingAtALargeStepDoesNotDiverge) {
     const StepStatus s = t.Advance(x.data(), v.data(), ends, ends, 0.01, work.data());
     ASSERT_TRUE(s.ok) << "step " << k << ": " << s.reason;
     EXPECT_LT(t.Reactions(x.data(), v.data(), ends, work.data()).tension_a, 10 * weight) << k;
+  }
+}
+
+}  // namespace
+}  // namespace mjtether
+
+namespace mjtether {
+namespace {
+
+// Segments set the floor of the accuracy/cost chart: on the fixed line (12 s, the last 6 s),
+// the fairlead tension's RMS difference to 80 segments must fall with each doubling from 10 to
+// 40 segments, by at least 2 (the sweep measures 44 -> 17.7 -> 4.7 N against 160 segments
+// over 60 s; the discretisation is second order in space, a factor 4, less once the
+// reference's own error counts). implicit2 at 5 ms keeps the time error (0.1-2 N) below the
+// space error at these resolutions.
+TEST(Convergence, EndTensionErrorFallsWithSegments) {
+  const std::vector<double> ref = LineTension("implicit2", 0.005, 80);
+  double previous = INFINITY;
+  for (int N : {10, 20, 40}) {
+    const double e = Rms(LineTension("implicit2", 0.005, N), ref);
+    std::printf("%d segments: %.4g N against 80\n", N, e);
+    EXPECT_LT(2 * e, previous) << N;
+    previous = e;
   }
 }
 
