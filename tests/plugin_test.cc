@@ -12,6 +12,7 @@
 #include <mujoco/mujoco.h>
 
 #include "catenary_reference.h"
+#include "mujoco_fixture.h"
 #include "mjtether.h"
 
 namespace mjtether {
@@ -22,41 +23,7 @@ int g_previous_calls = 0;
 void CountingPassive(const mjModel*, mjData*) { ++g_previous_calls; }
 const bool g_installed_before = (mjcb_passive = CountingPassive, true);
 
-// MuJoCo warnings fail the test that triggers them; errors abort it with the message.
-void FailOnWarning(const char* message) { ADD_FAILURE() << "MuJoCo warning: " << message; }
-void AbortOnError(const char* message) {
-  std::fprintf(stderr, "MuJoCo error: %s\n", message);
-  std::abort();
-}
-
-class MuJoCoTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    mju_user_warning = FailOnWarning;
-    mju_user_error = AbortOnError;
-  }
-  void TearDown() override {
-    for (mjData* d : datas_) mj_deleteData(d);
-    for (mjModel* m : models_) {
-      Detach(m);
-      mj_deleteModel(m);
-    }
-  }
-  mjModel* Load(const std::string& xml, const std::string& name = "test.xml") {
-    std::string error;
-    mjModel* m = LoadModelFromString(xml, name, &error);
-    EXPECT_NE(m, nullptr) << error;
-    if (m) models_.push_back(m);
-    return m;
-  }
-  mjData* Make(mjModel* m) {
-    mjData* d = mj_makeData(m);
-    datas_.push_back(d);
-    return d;
-  }
-  std::vector<mjModel*> models_;
-  std::vector<mjData*> datas_;
-};
+using MuJoCoTest = testing::MuJoCoFixture;
 
 // ---------------------------------------------------------------------------------------------
 // Models

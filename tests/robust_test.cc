@@ -17,45 +17,13 @@
 #include <vector>
 
 #include "mjtether.h"
+#include "mujoco_fixture.h"
 
 namespace mjtether {
 namespace {
 
-void FailOnWarning(const char* message) { ADD_FAILURE() << "MuJoCo warning: " << message; }
-void AbortOnError(const char* message) {
-  std::fprintf(stderr, "MuJoCo error: %s\n", message);
-  std::abort();
-}
-
 // Loads models from strings, deletes them and their data at the end of the test.
-class Scene : public ::testing::Test {
- protected:
-  void SetUp() override {
-    mju_user_warning = FailOnWarning;
-    mju_user_error = AbortOnError;
-  }
-  void TearDown() override {
-    for (mjData* d : datas_) mj_deleteData(d);
-    for (mjModel* m : models_) {
-      Detach(m);
-      mj_deleteModel(m);
-    }
-  }
-  mjModel* Load(const std::string& xml, const std::string& name = "scene.xml") {
-    std::string error;
-    mjModel* m = LoadModelFromString(xml, name, &error);
-    EXPECT_NE(m, nullptr) << error;
-    if (m) models_.push_back(m);
-    return m;
-  }
-  mjData* Make(mjModel* m) {
-    mjData* d = mj_makeData(m);
-    datas_.push_back(d);
-    return d;
-  }
-  std::vector<mjModel*> models_;
-  std::vector<mjData*> datas_;
-};
+using Scene = testing::MuJoCoFixture;
 
 bool Contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;

@@ -17,6 +17,7 @@
 #include "catenary_reference.h"
 #include "declaration.h"
 #include "mjtether.h"
+#include "mujoco_fixture.h"
 #include "tether.h"
 
 namespace mjtether {
@@ -511,34 +512,8 @@ TEST_P(Integrators, CoincidentNodesUnfoldIntoADoubledStrand) {
 // ---------------------------------------------------------------------------------------------
 // Through MuJoCo: snap loads, a spinning and a teleported vehicle.
 
-void FailOnWarning(const char* message) { ADD_FAILURE() << "MuJoCo warning: " << message; }
-
-struct Model {
-  mjModel* m = nullptr;
-  mjData* d = nullptr;
-  explicit Model(const std::string& xml) {
-    mju_user_warning = FailOnWarning;
-    std::string error;
-    m = LoadModelFromString(xml, "stress.xml", &error);
-    EXPECT_NE(m, nullptr) << error;
-    if (m) d = mj_makeData(m);
-  }
-  ~Model() {
-    if (d) mj_deleteData(d);
-    if (m) {
-      Detach(m);
-      mj_deleteModel(m);
-    }
-  }
-  bool Step() {
-    mj_step(m, d);
-    if (std::optional<std::string> message = CheckDivergence(m, d)) {
-      ADD_FAILURE() << *message;
-      return false;
-    }
-    return true;
-  }
-};
+// A loaded model and its data, released at the end of the scope.
+using Model = testing::LoadedScene;
 
 const char* Name(Integrator integrator) {
   return integrator == Integrator::kExplicit ? "explicit" : "implicit";

@@ -11,6 +11,7 @@
 #include <mujoco/mujoco.h>
 
 #include "mjtether.h"
+#include "mujoco_fixture.h"
 #include "validation_record.h"
 
 namespace mjtether {
@@ -25,39 +26,9 @@ using testing::Record;
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kG = 9.81;
 
-void FailOnWarning(const char* message) { ADD_FAILURE() << "MuJoCo warning: " << message; }
-void AbortOnError(const char* message) {
-  std::fprintf(stderr, "MuJoCo error: %s\n", message);
-  std::abort();
-}
-
 // A loaded model and its data, released at the end of the scope.
-struct Scene {
-  mjModel* m = nullptr;
-  mjData* d = nullptr;
-  explicit Scene(const std::string& xml) {
-    mju_user_warning = FailOnWarning;
-    mju_user_error = AbortOnError;
-    std::string error;
-    m = LoadModelFromString(xml, "validation.xml", &error);
-    EXPECT_NE(m, nullptr) << error;
-    if (m) d = mj_makeData(m);
-  }
-  ~Scene() {
-    if (d) mj_deleteData(d);
-    if (m) {
-      Detach(m);
-      mj_deleteModel(m);
-    }
-  }
-  bool Step() {
-    mj_step(m, d);
-    if (auto message = CheckDivergence(m, d)) {
-      ADD_FAILURE() << *message;
-      return false;
-    }
-    return true;
-  }
+struct Scene : testing::LoadedScene {
+  explicit Scene(const std::string& xml) : LoadedScene(xml, "validation.xml") {}
   double MaxQvel() const {
     double s = 0;
     for (int i = 0; i < m->nv; ++i) s = std::max(s, std::abs(d->qvel[i]));

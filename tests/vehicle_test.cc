@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "mjtether.h"
+#include "mujoco_fixture.h"
 #include "rov_controller.h"  // examples/: the controller example's control law
 #include "vehicle_declaration.h"
 
@@ -22,32 +23,8 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kRho = 1025;  // [kg/m^3]
 constexpr double kG = 9.81;    // [m/s^2]
 
-void FailOnWarning(const char* message) { ADD_FAILURE() << "MuJoCo warning: " << message; }
-void AbortOnError(const char* message) {
-  std::fprintf(stderr, "MuJoCo error: %s\n", message);
-  std::abort();
-}
-
-class VehicleTest : public ::testing::Test {
+class VehicleTest : public testing::MuJoCoFixture {
  protected:
-  void SetUp() override {
-    mju_user_warning = FailOnWarning;
-    mju_user_error = AbortOnError;
-  }
-  void TearDown() override {
-    for (mjData* d : datas_) mj_deleteData(d);
-    for (mjModel* m : models_) {
-      Detach(m);
-      mj_deleteModel(m);
-    }
-  }
-  mjModel* Load(const std::string& xml, const std::string& name = "vehicle.xml") {
-    std::string error;
-    mjModel* m = LoadModelFromString(xml, name, &error);
-    EXPECT_NE(m, nullptr) << error;
-    if (m) models_.push_back(m);
-    return m;
-  }
   std::string LoadError(const std::string& xml) {
     std::string error;
     mjModel* m = LoadModelFromString(xml, "bad.xml", &error);
@@ -57,13 +34,6 @@ class VehicleTest : public ::testing::Test {
     }
     return error;
   }
-  mjData* Make(mjModel* m) {
-    mjData* d = mj_makeData(m);
-    datas_.push_back(d);
-    return d;
-  }
-  std::vector<mjModel*> models_;
-  std::vector<mjData*> datas_;
 };
 
 // The BlueROV2 of Wu (2018), as in models/bluerov2_heavy.xml: 11.5 kg, 0.16 kg m^2.

@@ -1,0 +1,95 @@
+// A GoogleTest fixture for tests through MuJoCo: models loaded from strings (with their
+// tethers attached), data made from them, everything deleted at the end of the test. MuJoCo
+// warnings fail the test that triggers them; errors abort it with the message (MuJoCo's
+// default handler would wait on stdin).
+#ifndef MJTETHER_TESTS_MUJOCO_FIXTURE_H_
+#define MJTETHER_TESTS_MUJOCO_FIXTURE_H_
+
+#include <cstdio>
+#include <cstdlib>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
+
+#include "mjtether.h"
+
+namespace mjtether::testing {
+
+inline void FailOnWarning(const char* message) {
+  ADD_FAILURE() << "MuJoCo warning: " << message;
+}
+
+inline void AbortOnError(const char* message) {
+  std::fprintf(stderr, "MuJoCo error: %s\n", message);
+  std::abort();
+}
+
+class MuJoCoFixture : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    mju_user_warning = FailOnWarning;
+    mju_user_error = AbortOnError;
+  }
+  void TearDown() override {
+    for (mjData* d : datas_) mj_deleteData(d);
+    for (mjModel* m : models_) {
+      Detach(m);
+      mj_deleteModel(m);
+    }
+  }
+  // Loads MJCF text; `name` stands for the file in messages. Fails the test on error.
+  mjModel* Load(const std::string& xml, const std::string& name = "test.xml") {
+    std::string error;
+    mjModel* m = LoadModelFromString(xml, name, &error);
+    EXPECT_NE(m, nullptr) << error;
+    if (m) models_.push_back(m);
+    return m;
+  }
+  mjData* Make(mjModel* m) {
+    mjData* d = mj_makeData(m);
+    datas_.push_back(d);
+    return d;
+  }
+  std::vector<mjModel*> models_;
+  std::vector<mjData*> datas_;
+};
+
+// A model loaded from a string and its data, released at the end of the scope; for tests
+// that need several scenes at once or a scene outside a fixture.
+struct LoadedScene {
+  mjModel* m = nullptr;
+  mjData* d = nullptr;
+  explicit LoadedScene(const std::string& xml, const std::string& name = "test.xml") {
+    mju_user_warning = FailOnWarning;
+    mju_user_error = AbortOnError;
+    std::string error;
+    m = LoadModelFromString(xml, name, &error);
+    EXPECT_NE(m, nullptr) << error;
+    if (m) d = mj_makeData(m);
+  }
+  LoadedScene(const LoadedScene&) = delete;
+  LoadedScene& operator=(const LoadedScene&) = delete;
+  ~LoadedScene() {
+    if (d) mj_deleteData(d);
+    if (m) {
+      Detach(m);
+      mj_deleteModel(m);
+    }
+  }
+  // One mj_step; a divergence fails the test with the engine's message.
+  bool Step() {
+    mj_step(m, d);
+    if (std::optional<std::string> message = CheckDivergence(m, d)) {
+      ADD_FAILURE() << *message;
+      return false;
+    }
+    return true;
+  }
+};
+
+}  // namespace mjtether::testing
+
+#endif  // MJTETHER_TESTS_MUJOCO_FIXTURE_H_
