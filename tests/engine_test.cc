@@ -9,6 +9,7 @@
 #include "band_cholesky.h"
 #include "catenary_reference.h"
 #include "declaration.h"
+#include "make_tether.h"
 #include "tether.h"
 
 namespace mjtether {
@@ -32,17 +33,6 @@ struct Sim {
   EndReactions Reactions() { return tether.Reactions(x.data(), v.data(), ends, work.data()); }
 };
 
-Tether Make(const TetherParams& p, const Environment& env, const std::string& effects = "") {
-  TetherParams q = p;
-  DeclarationError e;
-  std::optional<unsigned> fx = ResolveEffects(q, env, effects, &e);
-  EXPECT_TRUE(fx.has_value()) << e.message;
-  q.effects = fx.value_or(kAxial);
-  std::string error;
-  std::optional<Tether> t = Tether::Create(q, env, &error);
-  EXPECT_TRUE(t.has_value()) << error;
-  return *t;
-}
 
 TetherParams CatenaryParams(int segments) {
   TetherParams p;

@@ -18,6 +18,7 @@
 #include "declaration.h"
 #include "mjtether.h"
 #include "mujoco_fixture.h"
+#include "make_tether.h"
 #include "tether.h"
 
 namespace mjtether {
@@ -30,17 +31,6 @@ constexpr double kStep = 0.002;  // [s] the vehicle's time step
 // ---------------------------------------------------------------------------------------------
 // The engine alone, with ends that may move.
 
-Tether Make(const TetherParams& p, const Environment& env) {
-  TetherParams q = p;
-  DeclarationError e;
-  std::optional<unsigned> fx = ResolveEffects(q, env, "", &e);
-  EXPECT_TRUE(fx.has_value()) << e.message;
-  q.effects = fx.value_or(kAxial);
-  std::string error;
-  std::optional<Tether> t = Tether::Create(q, env, &error);
-  EXPECT_TRUE(t.has_value()) << error;
-  return *t;
-}
 
 struct Sim {
   Tether tether;
