@@ -180,9 +180,7 @@ int Info(const std::string& path) {
     const mjtether::TetherParams& p = t->params();
     std::cout << "  tether '" << mjtether::TetherName(m, k) << "': " << p.segments
               << " segments of " << t->rest_segment_length() << " m, "
-              << (p.integrator == mjtether::Integrator::kExplicit   ? "explicit"
-                  : p.integrator == mjtether::Integrator::kImplicit2 ? "implicit2"
-                                                                      : "implicit")
+              << mjtether::IntegratorName(p.integrator)
               << ", effects " << mjtether::EffectsToString(p.effects) << "\n"
               << "    explicit stable step " << t->ExplicitStableStep() << " s; "
               << t->SubstepsFor(m->opt.timestep) << " tether step(s) per MuJoCo step\n";

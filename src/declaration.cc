@@ -308,9 +308,11 @@ std::optional<TetherDeclaration> ParseTether(const std::string& text, const Envi
         p.integrator = Integrator::kImplicit;
       } else if (value == "implicit2") {
         p.integrator = Integrator::kImplicit2;
+      } else if (value == "rk4") {
+        p.integrator = Integrator::kRK4;
       } else {
         ok = Fail(error, key,
-                  "key 'integrator' = " + value + "; allowed: explicit, implicit, implicit2");
+                  "key 'integrator' = " + value + "; allowed: explicit, implicit, implicit2, rk4");
       }
     } else if (key == "bending") {
       if (value == "galerkin") {

@@ -46,7 +46,21 @@ enum class Integrator {
   kExplicit,  // symplectic Euler, substeps from the stability limit
   kImplicit,  // linearised backward Euler, banded solve
   kImplicit2,  // two-stage L-stable SDIRK (second order), each stage a backward-Euler solve
+  kRK4,       // classical fourth-order Runge-Kutta, substeps from its own stability limit
 };
+
+// Explicit schemes take substeps at their stability limit; implicit ones take the MuJoCo step.
+inline bool IsExplicit(Integrator i) { return i == Integrator::kExplicit || i == Integrator::kRK4; }
+// The name a declaration uses for it (key `integrator`).
+inline const char* IntegratorName(Integrator i) {
+  switch (i) {
+    case Integrator::kExplicit: return "explicit";
+    case Integrator::kImplicit: return "implicit";
+    case Integrator::kImplicit2: return "implicit2";
+    case Integrator::kRK4: return "rk4";
+  }
+  return "?";
+}
 
 // The water a tether is in (declared by <text name="water">). Absent: a dry scene.
 struct Water {

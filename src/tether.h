@@ -79,7 +79,7 @@ class Tether {
 
   // Largest stable step of the explicit scheme [s]: 2/omega_max with the highest natural
   // frequency estimated from axial stiffness, bending, seabed stiffness and the node masses,
-  // reduced for damping (see tether.cc).
+  // reduced for damping (see tether.cc); with integrator=rk4, the limit of RK4 (about 2.8/w).
   double ExplicitStableStep() const { return explicit_dt_; }
   // Number of tether steps to cover dt [s] with the configured integrator.
   int SubstepsFor(double dt) const;
@@ -134,8 +134,11 @@ class Tether {
   void AddSeabed(ConstNodes x, ConstNodes v, ConstNodes q, Nodes f) const;
 
   // Integrators (one step of size h; ends already set at the start, `next` at the end).
+  Vec3 Acceleration(int i, const Vec3& fi, const Vec3& qi) const;
   void ExplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
                     double* work) const;
+  void Rk4Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
+               double* work) const;
   bool ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
                     double* work) const;
   void ImplicitStepAdaptive(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
@@ -156,6 +159,8 @@ class Tether {
   double explicit_dt_ = 0;      // [s]
   Eigen::VectorXd mass_;        // [kg] (n) dry lumped mass
   Eigen::VectorXd added_;       // [kg] (n) normal added mass Can rho A l_i
+  Eigen::VectorXd inv_mass_;          // [1/kg] (n) 1/m_i (multiplying is cheaper than dividing)
+  Eigen::VectorXd inv_mass_normal_;   // [1/kg] (n) 1/(m_i + ma_i)
   Eigen::VectorXd share_;       // [m] (n) rest length lumped at each node
   Eigen::Matrix3Xd weight_;     // [N] (3 x n) weight minus buoyancy per node
   // The same tether cut to its first two segments (N >= 3): the end reactions depend only on

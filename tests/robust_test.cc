@@ -244,7 +244,7 @@ INSTANTIATE_TEST_SUITE_P(
                  "tether:u", "segments", "whole number"},
         BadInput{"huge_coefficient", kGoodWater, BadTether("Cdn=1.2", "Cdn=1e9"), "tether:u", "Cdn",
                  "[0, 100]"},
-        BadInput{"bad_word", kGoodWater, std::string(kGoodTether) + " integrator=rk4", "tether:u",
+        BadInput{"bad_word", kGoodWater, std::string(kGoodTether) + " integrator=rk5", "tether:u",
                  "integrator", "explicit, implicit"},
         BadInput{"missing_site", kGoodWater, BadTether("ends=a,b", "ends=a,c"), "tether:u", "ends",
                  "no site named 'c'"},
