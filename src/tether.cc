@@ -738,33 +738,30 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
       }
     }
     // Bending: K = -EI/w g g^T I on the stencil of each curvature; B = h^2 EI/(w L0^2) g g^T I.
+    // Every block is a multiple of I: the stencils add scalars per block row (on the diagonal,
+    // first and second band), gathered in the free moment buffer, then one pass adds them.
     if (Has(kBending)) {
-      auto stencil = [&](const int* nodes, const double* g, int count, double weight) {
+      double* band0 = w.M;  // 3 x n scratch (the moments are no longer needed): D, L1, L2
+      std::fill(band0, band0 + 3 * n, 0.0);
+      auto stencil = [&](int first, const double* g, int count, double weight) {
         const double k = h2 * p_.EI / (weight * L0_ * L0_);
         for (int a = 0; a < count; ++a) {
-          if (!Dynamic(nodes[a])) continue;
-          const int ua = nodes[a] - 1;
+          const int ia = first + a;
+          if (!Dynamic(ia)) continue;
           for (int b = 0; b <= a; ++b) {
-            if (!Dynamic(nodes[b])) continue;
-            const double s = k * g[a] * g[b];
-            const int gap = a - b;
-            BlockBand::Block blk = gap == 0 ? A.D(ua) : gap == 1 ? A.L1(ua) : A.L2(ua);
-            blk.diagonal().array() += s;
+            if (!Dynamic(first + b)) continue;
+            band0[3 * (ia - 1) + (a - b)] += k * g[a] * g[b];
           }
         }
       };
       const double g3[3] = {1, -2, 1}, g2[2] = {-1, 1};
-      for (int i = 1; i < N_; ++i) {
-        const int nodes[3] = {i - 1, i, i + 1};
-        stencil(nodes, g3, 3, L0_);
-      }
-      if (Has(kClamp) && p_.clamp_a) {
-        const int nodes[2] = {0, 1};
-        stencil(nodes, g2, 2, 0.5 * L0_);
-      }
-      if (Has(kClamp) && p_.clamp_b) {
-        const int nodes[2] = {N_ - 1, N_};
-        stencil(nodes, g2, 2, 0.5 * L0_);
+      for (int i = 1; i < N_; ++i) stencil(i - 1, g3, 3, L0_);
+      if (Has(kClamp) && p_.clamp_a) stencil(0, g2, 2, 0.5 * L0_);
+      if (Has(kClamp) && p_.clamp_b) stencil(N_ - 1, g2, 2, 0.5 * L0_);
+      for (int u = 0; u < nu; ++u) {
+        A.D(u).diagonal().array() += band0[3 * u];
+        if (u >= 1) A.L1(u).diagonal().array() += band0[3 * u + 1];
+        if (u >= 2) A.L2(u).diagonal().array() += band0[3 * u + 2];
       }
     }
     // Drag: d(|vn| vn)/dv_r = |vn| P + vn vn^T/|vn|, d(|vt| vt)/dv_r = 2 |vt| q q^T; B = -h D.
