@@ -93,6 +93,9 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
       !(params.diameter > 0)) {
     return fail("length, EA, mass_per_length and diameter must be > 0");
   }
+  if ((params.effects & kCompression) && !(params.EAc > 0)) {
+    return fail("the compression effect needs EAc > 0");
+  }
   Tether tether;
   Tether& c = tether;
   c.p_ = params;
@@ -134,7 +137,8 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
   }
 
   // Explicit stability limit. Highest frequencies of the discrete operators on the lightest
-  // dynamic node: axial chain 4 (EA/L0)/m, fourth difference 16 EI/(L0^3 m) (doubled when an
+  // dynamic node: axial chain 4 (EA/L0)/m (with the larger of EA and EAc when compressed
+  // segments push back: a compressed chain rings at the same frequency), fourth difference 16 EI/(L0^3 m) (doubled when an
   // end is clamped, whose curvature weight is L0/2), seabed k l / m. Damping (internal,
   // seabed, friction) shortens the limit of symplectic Euler to 2/w (sqrt(1+z^2) - z).
   double m_min = INFINITY, mn_min = INFINITY;
@@ -146,7 +150,8 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
   if (!std::isfinite(m_min)) {
     c.explicit_dt_ = INFINITY;  // no dynamic node (one segment between two sites)
   } else {
-    double w2 = 4 * (params.EA / c.L0_) / m_min;
+    const double ea = c.Has(kCompression) ? std::max(params.EA, params.EAc) : params.EA;
+    double w2 = 4 * (ea / c.L0_) / m_min;
     if (c.Has(kBending)) {
       w2 += (c.Has(kClamp) ? 32 : 16) * params.EI / (c.L0_ * c.L0_ * c.L0_ * mn_min);
     }
@@ -274,10 +279,19 @@ void Tether::SegmentGeometry(ConstNodes x, Nodes t, double* l) const {
 
 // Axial: T_j = EA eps_j + damping deps_j/dt, eps_j = l_j/L0 - 1, zero when slack (eps <= 0)
 // and never negative (Buckham et al. 2003, eq. for the viscoelastic segment).
+//
+// With the compression effect (EAc declared) a shortened segment pushes back instead, the way
+// OrcaFlex lets a line "allow compression": for eps < 0, T_j = min(0, EAc eps_j + damping
+// deps_j/dt) (the mirror of the taut law: damping never makes a shortened segment pull). This
+// is what keeps the segments of a bending tether at their length at zero tension, where the
+// bending shear would otherwise fold them (Buckham et al.'s low-tension model relies on the
+// segments keeping their length). T[j] reports the tension only (>= 0); a compression is
+// reported as 0, like slack.
 void Tether::AddAxial(ConstNodes x, ConstNodes v, ConstNodes t, const double* l, double* T,
                       Nodes f) const {
   (void)x;
   const bool damped = Has(kDamping);
+  const bool compression = Has(kCompression);
   for (int j = 0; j < N_; ++j) {
     const double eps = l[j] / L0_ - 1;
     double Tj = 0;
@@ -285,8 +299,12 @@ void Tether::AddAxial(ConstNodes x, ConstNodes v, ConstNodes t, const double* l,
       Tj = p_.EA * eps;
       if (damped) Tj += p_.damping * t.col(j).dot(v.col(j + 1) - v.col(j)) / L0_;
       Tj = std::max(Tj, 0.0);
+    } else if (compression && eps < 0) {
+      Tj = p_.EAc * eps;
+      if (damped) Tj += p_.damping * t.col(j).dot(v.col(j + 1) - v.col(j)) / L0_;
+      Tj = std::min(Tj, 0.0);
     }
-    T[j] = Tj;
+    T[j] = std::max(Tj, 0.0);
     f.col(j) += Tj * t.col(j);
     f.col(j + 1) -= Tj * t.col(j);
   }
@@ -470,6 +488,7 @@ EndReactions Tether::Reactions(const double* xp, const double* vp, const Ends& e
   return r;
 }
 
+// Tension only: a compressed segment (compression effect) reads 0, like a slack one.
 void Tether::Tensions(const double* xp, const double* vp, double* T) const {
   ConstNodes x(xp, 3, N_ + 1), v(vp, 3, N_ + 1);
   for (int j = 0; j < N_; ++j) {
@@ -508,6 +527,7 @@ double Tether::PotentialEnergy(const double* xp, const Ends& ends) const {
     Vec3 dx = x.col(j + 1) - x.col(j);
     const double l = dx.norm();
     if (Has(kAxial) && l > L0_) E += 0.5 * p_.EA / L0_ * (l - L0_) * (l - L0_);
+    if (Has(kCompression) && l < L0_) E += 0.5 * p_.EAc / L0_ * (l - L0_) * (l - L0_);
     Vec3 t = l > 0 ? Vec3(dx / l) : Vec3::Zero();
     // Bending: the potential of the forces of AddBending is EI/w (1 - cos theta) per node
     // (theta the turning angle, w the curvature weight), since M = EI sin(theta)/w.
@@ -626,15 +646,28 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
     // Axial stiffness and damping of taut segments: B = h D + h^2 K with
     // K = EA/L0 t t^T + T/l (I - t t^T), D = damping/L0 t t^T; +B on both diagonal blocks,
     // -B on the coupling block.
+    // A compressed segment (compression effect, 0 < l < L0) adds h^2 EAc/L0 t t^T and its
+    // damping while it pushes, without the geometric term -|T|/l (I - t t^T): that negative
+    // stiffness (buckling) would make the matrix indefinite, and bending carries it instead.
     if (Has(kAxial)) {
       const double ka = p_.EA / L0_;
+      const double kc = p_.EAc / L0_;
       const double ca = Has(kDamping) ? p_.damping / L0_ : 0;
+      const bool compression = Has(kCompression);
       for (int j = 0; j < N_; ++j) {
-        if (!(w.l[j] > L0_)) continue;
+        const bool taut = w.l[j] > L0_;
+        if (!taut && !(compression && w.l[j] > 0 && w.l[j] < L0_)) continue;
         const Vec3 tj = t.col(j);
-        const double geo = h2 * w.T[j] / w.l[j];
-        const double along = h2 * ka + (w.T[j] > 0 ? h * ca : 0) - geo;
-        const Mat3 B = along * tj * tj.transpose() + geo * I;
+        Mat3 B;
+        if (taut) {
+          const double geo = h2 * w.T[j] / w.l[j];
+          const double along = h2 * ka + (w.T[j] > 0 ? h * ca : 0) - geo;
+          B = along * tj * tj.transpose() + geo * I;
+        } else {
+          const double rate = tj.dot(vk.col(j + 1) - vk.col(j)) / L0_;  // [1/s] deps/dt
+          const bool pushes = p_.EAc * (w.l[j] / L0_ - 1) + ca * L0_ * rate < 0;
+          B = (h2 * kc + (pushes ? h * ca : 0)) * tj * tj.transpose();
+        }
         const bool d0 = Dynamic(j), d1 = Dynamic(j + 1);
         if (d0) A.D(j - 1) += B;
         if (d1) A.D(j) += B;
@@ -713,7 +746,8 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
     }
     A.Solve(w.rhs);
     for (int i = 1; i <= nu; ++i) vk.col(i) += rhs.col(i - 1);
-    // Did a segment change between slack and taut? Then the linearisation was wrong there.
+    // Did a segment change between slack (or compressed) and taut? Then the linearisation was
+    // wrong there: the law changes at l = L0 (from nothing or EAc to EA).
     place();
     bool changed = false;
     const double L0sq = L0_ * L0_;
@@ -846,7 +880,8 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
 }
 
 // The most energy the tether can hold without diverging [J]: elastic energy at max_strain
-// along its whole length, ½ EA max_strain² L; bending energy of a fold at every node,
+// along its whole length, ½ EA max_strain² L; with compression, every segment shortened to
+// nothing, ½ EAc L; bending energy of a fold at every node,
 // ½ EI (2/L0)² L; the kinetic energy of the whole tether (with added mass) moving with its
 // fastest end plus the current; and the work of its net weight falling its own length.
 double Tether::EnergyBound(const Ends& from, const Ends& to) const {
@@ -857,6 +892,7 @@ double Tether::EnergyBound(const Ends& from, const Ends& to) const {
   const double M = mass_.sum() + added_.sum();
   double E = 0.5 * p_.EA * p_.max_strain * p_.max_strain * L + 0.5 * M * v * v;
   if (Has(kBending)) E += 0.5 * p_.EI * (4 / (L0_ * L0_)) * L;
+  if (Has(kCompression)) E += 0.5 * p_.EAc * L;
   double W = 0;  // [N] net weight, without sign
   for (int i = 0; i <= N_; ++i) W += weight_.col(i).norm();
   return E + W * L;
