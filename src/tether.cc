@@ -236,23 +236,74 @@ void Tether::InitialShape(const Ends& ends, double* xp, double* vp) const {
       h = horiz.norm();
     }
     const Vec3 eh = horiz / h;
-    // Solve sinh(xi)/xi = r for xi = h/(2a) by bisection (monotone in xi).
-    const double r = std::sqrt(L * L - vspan * vspan) / h;
-    double lo = 0, hi = 1;
-    while (std::sinh(hi) / hi < r && hi < 700) hi *= 2;
-    for (int it = 0; it < 200; ++it) {
-      double mid = 0.5 * (lo + hi);
-      (std::sinh(mid) / mid < r ? lo : hi) = mid;
-    }
-    const double xi = 0.5 * (lo + hi);
-    const double a = h / (2 * xi);
-    const double x0 = h / 2 - a * std::atanh(vspan / L);  // abscissa of the lowest point
-    const double sA = a * std::sinh(-x0 / a);               // arc coordinate of end A
-    for (int k = 0; k <= N_; ++k) {
-      const double s = sA + L * k / N_;
-      const double xc = x0 + a * std::asinh(s / a);
-      const double yc = a * (std::cosh((xc - x0) / a) - std::cosh(x0 / a));
-      x.col(k) = A + xc * eh + yc * up;
+    // The catenary of arc length Ls through both ends: its parameter a, the abscissa x0 of its
+    // lowest point and the arc coordinate sA of end A (arc coordinates from the lowest point).
+    struct Curve {
+      double a, x0, sA;
+    };
+    auto solve = [&](double Ls) {
+      // Solve sinh(xi)/xi = r for xi = h/(2a) by bisection (monotone in xi).
+      const double r = std::sqrt(Ls * Ls - vspan * vspan) / h;
+      double lo = 0, hi = 1;
+      while (std::sinh(hi) / hi < r && hi < 700) hi *= 2;
+      for (int it = 0; it < 200; ++it) {
+        double mid = 0.5 * (lo + hi);
+        (std::sinh(mid) / mid < r ? lo : hi) = mid;
+      }
+      const double xi = 0.5 * (lo + hi);
+      Curve c;
+      c.a = h / (2 * xi);
+      c.x0 = h / 2 - c.a * std::atanh(vspan / Ls);  // abscissa of the lowest point
+      c.sA = c.a * std::sinh(-c.x0 / c.a);            // arc coordinate of end A
+      return c;
+    };
+    auto point = [&](const Curve& c, double s) -> Vec3 {
+      const double xc = c.x0 + c.a * std::asinh(s / c.a);
+      const double yc = c.a * (std::cosh((xc - c.x0) / c.a) - std::cosh(c.x0 / c.a));
+      return A + xc * eh + yc * up;
+    };
+    const Curve c = solve(L);
+    for (int k = 0; k <= N_; ++k) x.col(k) = point(c, c.sA + L * k / N_);
+    // With compression, nodes at arc spacing L0 would start compressed (a chord is shorter than
+    // its arc by ~L0^3 kappa^2 / 24) and spring apart at the first step. Instead walk chords of
+    // exactly L0 along a catenary a little longer than L, its length found by the secant method
+    // so that the N-th chord ends on B. Kept as above if the walk fails (a hairpin U).
+    if (Has(kCompression)) {
+      // Arc coordinate reached beyond end B after N chords of L0 on the catenary of length Ls.
+      auto walk = [&](double Ls, bool store) -> double {
+        const Curve cs = solve(Ls);
+        double sk = cs.sA;
+        Vec3 P = A;
+        for (int k = 1; k <= N_; ++k) {
+          // Newton on |P(s) - P|^2 = L0^2, from one arc length L0 on (the chord is shorter).
+          double s = sk + L0_;
+          for (int it = 0; it < 50; ++it) {
+            const Vec3 d = point(cs, s) - P;
+            const double q = s / cs.a;
+            const Vec3 tangent = (eh + q * up) / std::sqrt(1 + q * q);  // dP/ds
+            const double slope = 2 * d.dot(tangent);
+            if (!(slope > 0)) return NAN;
+            const double ds = (d.squaredNorm() - L0_ * L0_) / slope;
+            s -= ds;
+            if (std::abs(ds) <= 1e-14 * (std::abs(s) + L0_)) break;
+          }
+          sk = s;
+          P = point(cs, sk);
+          if (store) x.col(k) = P;
+        }
+        return sk - (cs.sA + Ls);
+      };
+      double L1 = L, f1 = walk(L1, false);
+      double L2 = L + f1, f2 = walk(L2, false);
+      for (int it = 0; it < 50 && std::isfinite(f2) && std::abs(f2) > 1e-13 * L && f2 != f1;
+           ++it) {
+        const double L3 = L2 - f2 * (L2 - L1) / (f2 - f1);
+        L1 = L2;
+        f1 = f2;
+        L2 = L3;
+        f2 = walk(L2, false);
+      }
+      if (std::isfinite(f2) && std::abs(f2) <= 1e-9 * L) walk(L2, true);
     }
     x.col(N_) = B;  // remove round-off at the far end
   }
