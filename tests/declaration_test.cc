@@ -56,6 +56,19 @@ TEST(Declaration, ZeroCoefficientsTurnEffectsOff) {
   EXPECT_EQ(EffectsToString(d->params.effects), "axial,weight,buoyancy,seabed");
 }
 
+// EAc declares the compression effect (last in the list); without it there is none.
+TEST(Declaration, EAcTurnsCompressionOn) {
+  DeclarationError e;
+  std::optional<TetherDeclaration> d =
+      ParseTether(std::string(kExample) + " EAc=2e5", Environment(), &e);
+  ASSERT_TRUE(d) << e.message;
+  EXPECT_DOUBLE_EQ(d->params.EAc, 2e5);
+  EXPECT_EQ(EffectsToString(d->params.effects), "axial,damping,bending,weight,compression");
+  d = ParseTether(std::string(kExample) + " EAc=2e5 effects=axial,bending", Environment(), &e);
+  ASSERT_TRUE(d) << e.message;
+  EXPECT_EQ(d->params.effects, unsigned(kAxial | kBending));
+}
+
 TEST(Declaration, ExplicitEffectsReplaceDefaults) {
   DeclarationError e;
   std::optional<TetherDeclaration> d =
@@ -124,7 +137,15 @@ INSTANTIATE_TEST_SUITE_P(
                 "allowed"},
         BadCase{"effect without coefficient", With("EI=0.5", "EI=0") + " effects=axial,bending",
                 "effects", "EI > 0"},
-        BadCase{"no axial", std::string(kExample) + " effects=drag", "effects", "axial"}));
+        BadCase{"no axial", std::string(kExample) + " effects=drag", "effects", "axial"},
+        BadCase{"EAc not a number", std::string(kExample) + " EAc=stiff", "EAc",
+                "not a number"},
+        BadCase{"EAc NaN", std::string(kExample) + " EAc=nan", "EAc", "not a finite number"},
+        BadCase{"EAc zero", std::string(kExample) + " EAc=0", "EAc", "(0, 1e+13]"},
+        BadCase{"EAc negative", std::string(kExample) + " EAc=-2e5", "EAc", "(0, 1e+13]"},
+        BadCase{"EAc huge", std::string(kExample) + " EAc=1e14", "EAc", "(0, 1e+13]"},
+        BadCase{"compression without EAc", std::string(kExample) + " effects=axial,compression",
+                "effects", "EAc > 0"}));
 
 TEST(Declaration, MalformedTextIsRejected) {
   DeclarationError e;
