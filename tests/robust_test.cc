@@ -259,6 +259,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"negative", kGoodWater, BadTether("damping=5", "damping=-5"), "tether:u",
                  "damping", "[0, 1e+12]"},
         BadInput{"zero", kGoodWater, BadTether("EA=1e5", "EA=0"), "tether:u", "EA", "(0, 1e+13]"},
+        BadInput{"negative_EAc", kGoodWater, std::string(kGoodTether) + " EAc=-1e5", "tether:u",
+                 "EAc", "(0, 1e+13]"},
         BadInput{"huge_segments", kGoodWater, BadTether("segments=10", "segments=1e9"), "tether:u",
                  "segments", "[1, 100000]"},
         BadInput{"fractional_segments", kGoodWater, BadTether("segments=10", "segments=10.5"),
