@@ -137,8 +137,8 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
   }
 
   // Explicit stability limit. Highest frequencies of the discrete operators on the lightest
-  // dynamic node: axial chain 4 (EA/L0)/m (with the larger of EA and EAc when compressed
-  // segments push back: a compressed chain rings at the same frequency), fourth difference 16 EI/(L0^3 m) (doubled when an
+  // dynamic node: axial chain 4 (EA/L0)/m (EA the larger of EA and EAc when compressed
+  // segments push back), fourth difference 16 EI/(L0^3 m) (doubled when an
   // end is clamped, whose curvature weight is L0/2), seabed k l / m. Damping (internal,
   // seabed, friction) shortens the limit of symplectic Euler to 2/w (sqrt(1+z^2) - z).
   double m_min = INFINITY, mn_min = INFINITY;

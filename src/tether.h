@@ -109,7 +109,8 @@ class Tether {
   void Tensions(const double* x, const double* v, double* T) const;
 
   // Energies [J] for conservation checks: kinetic (with added mass), elastic (axial, with
-  // compression when declared, and bending) and gravitational (weight minus buoyancy, relative to z = 0).
+  // compression when declared, and bending) and gravitational (weight minus buoyancy,
+  // relative to z = 0).
   double KineticEnergy(const double* x, const double* v) const;
   double PotentialEnergy(const double* x, const Ends& ends) const;
   // The most energy the tether can hold physically while its ends move from `from` to `to`
