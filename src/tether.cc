@@ -335,9 +335,9 @@ void Tether::SegmentGeometry(ConstNodes x, Nodes t, double* l) const {
 // OrcaFlex lets a line "allow compression": for eps < 0, T_j = min(0, EAc eps_j + damping
 // deps_j/dt) (the mirror of the taut law: damping never makes a shortened segment pull). This
 // is what keeps the segments of a bending tether at their length at zero tension, where the
-// bending shear would otherwise fold them (Buckham et al.'s low-tension model relies on the
-// segments keeping their length). T[j] reports the tension only (>= 0); a compression is
-// reported as 0, like slack.
+// bending shear would otherwise fold them (the Galerkin curvature below, Buckham & Nahon,
+// weighs with the rest length L0, so it presumes segments near it). T[j] reports the tension
+// only (>= 0); a compression is reported as 0, like slack.
 void Tether::AddAxial(ConstNodes x, ConstNodes v, ConstNodes t, const double* l, double* T,
                       Nodes f) const {
   (void)x;

@@ -222,7 +222,7 @@ TEST_P(Integrators, ZeroTensionLoopWithBendingIsSmooth) {
 
 // The loop is the physics', not the integrator's: backward Euler at the vehicle's 2 ms step
 // (numerical damping of the unresolved axial modes) and symplectic Euler at the advisor's step
-// (7 times smaller, no numerical damping) end on the same shape: every node within 1 cm of the
+// (10 times smaller, no numerical damping) end on the same shape: every node within 1 cm of the
 // other run's (0.25% of the loop's reach; both are first-order schemes whose difference over
 // the slow, drag-dominated loop motion is O(h); measured 2 mm).
 TEST(Stress, ZeroTensionLoopIsTheSameWithBothIntegrators) {
