@@ -73,7 +73,8 @@ double TetherTime(const mjModel* m, const mjData* d, int k);
 // moments [N m], tension magnitudes [N]).
 EndReactions GetReactions(const mjModel* m, const mjData* d, int k);
 
-// Segment tensions of tether k [N] into T (N values).
+// Segment tensions of tether k [N] into T (N values), >= 0: a slack segment, or a compressed
+// one of a tether with EAc, reads 0.
 void GetTensions(const mjModel* m, const mjData* d, int k, double* T);
 
 // If a tether in d has diverged, a message naming the tether, the time and the node, and

@@ -309,6 +309,13 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
     if (!advice.empty()) {
       set->warnings.push_back(source + ": <text name=\"" + name + "\">: " + advice);
     }
+    // Bending without compression: at zero tension the bending shear shortens slack segments
+    // (README, Known limitations); EAc lets them keep their length.
+    if ((tether->params().effects & kBending) && !(tether->params().effects & kCompression)) {
+      set->warnings.push_back(source + ": <text name=\"" + name +
+                              "\">: EI > 0 without EAc: slack segments can shorten under "
+                              "bending; declare EAc (e.g. EAc = EA) for zero-tension loops");
+    }
     AttachedTether at{name.substr(7), *tether};
     const std::string sites[2] = {decl->site_a, decl->site_b};
     for (int end = 0; end < 2; ++end) {

@@ -200,6 +200,7 @@ std::optional<unsigned> ResolveEffects(const TetherParams& p, const Environment&
       {wet && env.water.has_seabed, wet && env.water.has_seabed, "water seabed=Z"},
       {(p.clamp_a || p.clamp_b) && p.EI > 0, (p.clamp_a || p.clamp_b) && p.EI > 0,
        "clamp=A|B|both and EI > 0"},
+      {p.EAc > 0, p.EAc > 0, "EAc > 0"},
   };
   unsigned effects = 0;
   if (effects_text.empty()) {
@@ -249,7 +250,8 @@ std::optional<TetherDeclaration> ParseTether(const std::string& text, const Envi
   static const char* const kKeys[] = {
       "ends",    "length", "segments",   "diameter", "mass_per_length", "EA",
       "EI",      "damping", "Cdn",       "Cdt",      "Can",             "integrator",
-      "clamp",   "effects", "substeps",  "max_step", "max_strain", "bending"};
+      "clamp",   "effects", "substeps",  "max_step", "max_strain", "bending",
+      "EAc"};
   static const char* const kRequired[] = {"ends",     "length",          "segments",
                                           "diameter", "mass_per_length", "EA"};
   std::optional<KeyValues> pairs = SplitKeyValues(text, error);
@@ -291,6 +293,8 @@ std::optional<TetherDeclaration> ParseTether(const std::string& text, const Envi
       ok = ParseInRange(key, value, {0, 1e5, true}, &p.mass_per_length, error);
     } else if (key == "EA") {
       ok = ParseInRange(key, value, {0, 1e13, true}, &p.EA, error);
+    } else if (key == "EAc") {
+      ok = ParseInRange(key, value, {0, 1e13, true}, &p.EAc, error);  // as EA: EAc = EA is usual
     } else if (key == "EI") {
       ok = ParseInRange(key, value, {0, 1e12, false}, &p.EI, error);
     } else if (key == "damping") {

@@ -50,8 +50,9 @@ std::optional<TetherDeclaration> ParseTether(const std::string& text, const Envi
 // The effects a tether simulates. Defaults: axial always; damping if damping > 0; bending if
 // EI > 0; weight if gravity != 0; in water buoyancy (gravity != 0), drag if Cdn or Cdt > 0,
 // added mass if Can > 0, current if the current is non-zero, seabed if declared; clamp if a
-// clamp is declared. `effects=` (comma list of kEffectNames) replaces the defaults; naming an
-// effect whose coefficient or declaration is missing is an error.
+// clamp is declared; compression if EAc > 0. `effects=` (comma list of kEffectNames)
+// replaces the defaults; naming an effect whose coefficient or declaration is missing is an
+// error.
 std::optional<unsigned> ResolveEffects(const TetherParams& p, const Environment& env,
                                        const std::string& effects_text, DeclarationError* error);
 

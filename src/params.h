@@ -16,7 +16,7 @@ using Vec3 = Eigen::Vector3d;
 
 // One bit per physical effect. An effect whose bit is clear is not evaluated at all.
 enum Effect : unsigned {
-  kAxial = 1u << 0,      // elastic tension EA*strain, tension only
+  kAxial = 1u << 0,      // elastic tension EA*strain, tension only (see kCompression)
   kDamping = 1u << 1,    // internal axial damping, damping*strain rate
   kBending = 1u << 2,    // bending stiffness EI (Galerkin curvature at the nodes)
   kWeight = 1u << 3,     // dry weight, mass_per_length * g
@@ -26,13 +26,15 @@ enum Effect : unsigned {
   kCurrent = 1u << 7,    // drag on the velocity relative to the current
   kSeabed = 1u << 8,     // flat seabed: penalty, damping, Coulomb friction
   kClamp = 1u << 9,      // clamped end(s): tangent held, bending moment to the body
+  kCompression = 1u << 10,  // shortened segments push back, EAc*strain (declared by EAc)
 };
 
 // Name of each effect as written in `effects=` (same order as the bits).
 inline constexpr const char* kEffectNames[] = {"axial",    "damping",    "bending", "weight",
                                                "buoyancy", "drag",       "added_mass",
-                                               "current",  "seabed",     "clamp"};
-inline constexpr int kNumEffects = 10;
+                                               "current",  "seabed",     "clamp",
+                                               "compression"};
+inline constexpr int kNumEffects = 11;
 
 // How nodal curvature is measured from the turning angle theta between two segments (both
 // give the same small-angle stiffness EI/w; they differ at large angles per node).
@@ -81,6 +83,7 @@ struct TetherParams {
   double diameter = 0;         // [m] hydrodynamic and buoyancy diameter d
   double mass_per_length = 0;  // [kg/m] dry mass per unstretched length
   double EA = 0;               // [N] axial stiffness
+  double EAc = 0;              // [N] axial stiffness in compression (l < L0); 0: tension only
   double EI = 0;               // [N m^2] bending stiffness
   double damping = 0;          // [N s] internal axial damping: T = EA*eps + damping*deps/dt
   double Cdn = 0;              // [-] normal drag coefficient, reference area d per length

@@ -132,6 +132,9 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
       !(params.diameter > 0)) {
     return fail("length, EA, mass_per_length and diameter must be > 0");
   }
+  if ((params.effects & kCompression) && !(params.EAc > 0)) {
+    return fail("the compression effect needs EAc > 0");
+  }
   Tether tether;
   Tether& c = tether;
   c.p_ = params;
@@ -175,7 +178,8 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
   }
 
   // Explicit stability limit. Highest frequencies of the discrete operators on the lightest
-  // dynamic node: axial chain 4 (EA/L0)/m, fourth difference 16 EI/(L0^3 m) (doubled when an
+  // dynamic node: axial chain 4 (EA/L0)/m (EA the larger of EA and EAc when compressed
+  // segments push back), fourth difference 16 EI/(L0^3 m) (doubled when an
   // end is clamped, whose curvature weight is L0/2), seabed k l / m. Damping (internal,
   // seabed, friction) shortens the limit of symplectic Euler to 2/w (sqrt(1+z^2) - z).
   double m_min = INFINITY, mn_min = INFINITY;
@@ -187,7 +191,8 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
   if (!std::isfinite(m_min)) {
     c.explicit_dt_ = INFINITY;  // no dynamic node (one segment between two sites)
   } else {
-    double w2 = 4 * (params.EA / c.L0_) / m_min;
+    const double ea = c.Has(kCompression) ? std::max(params.EA, params.EAc) : params.EA;
+    double w2 = 4 * (ea / c.L0_) / m_min;
     if (c.Has(kBending)) {
       w2 += (c.Has(kClamp) ? 32 : 16) * params.EI / (c.L0_ * c.L0_ * c.L0_ * mn_min);
     }
@@ -274,23 +279,74 @@ void Tether::InitialShape(const Ends& ends, double* xp, double* vp) const {
       h = horiz.norm();
     }
     const Vec3 eh = horiz / h;
-    // Solve sinh(xi)/xi = r for xi = h/(2a) by bisection (monotone in xi).
-    const double r = std::sqrt(L * L - vspan * vspan) / h;
-    double lo = 0, hi = 1;
-    while (std::sinh(hi) / hi < r && hi < 700) hi *= 2;
-    for (int it = 0; it < 200; ++it) {
-      double mid = 0.5 * (lo + hi);
-      (std::sinh(mid) / mid < r ? lo : hi) = mid;
-    }
-    const double xi = 0.5 * (lo + hi);
-    const double a = h / (2 * xi);
-    const double x0 = h / 2 - a * std::atanh(vspan / L);  // abscissa of the lowest point
-    const double sA = a * std::sinh(-x0 / a);               // arc coordinate of end A
-    for (int k = 0; k <= N_; ++k) {
-      const double s = sA + L * k / N_;
-      const double xc = x0 + a * std::asinh(s / a);
-      const double yc = a * (std::cosh((xc - x0) / a) - std::cosh(x0 / a));
-      x.col(k) = A + xc * eh + yc * up;
+    // The catenary of arc length Ls through both ends: its parameter a, the abscissa x0 of its
+    // lowest point and the arc coordinate sA of end A (arc coordinates from the lowest point).
+    struct Curve {
+      double a, x0, sA;
+    };
+    auto solve = [&](double Ls) {
+      // Solve sinh(xi)/xi = r for xi = h/(2a) by bisection (monotone in xi).
+      const double r = std::sqrt(Ls * Ls - vspan * vspan) / h;
+      double lo = 0, hi = 1;
+      while (std::sinh(hi) / hi < r && hi < 700) hi *= 2;
+      for (int it = 0; it < 200; ++it) {
+        double mid = 0.5 * (lo + hi);
+        (std::sinh(mid) / mid < r ? lo : hi) = mid;
+      }
+      const double xi = 0.5 * (lo + hi);
+      Curve c;
+      c.a = h / (2 * xi);
+      c.x0 = h / 2 - c.a * std::atanh(vspan / Ls);  // abscissa of the lowest point
+      c.sA = c.a * std::sinh(-c.x0 / c.a);            // arc coordinate of end A
+      return c;
+    };
+    auto point = [&](const Curve& c, double s) -> Vec3 {
+      const double xc = c.x0 + c.a * std::asinh(s / c.a);
+      const double yc = c.a * (std::cosh((xc - c.x0) / c.a) - std::cosh(c.x0 / c.a));
+      return A + xc * eh + yc * up;
+    };
+    const Curve c = solve(L);
+    for (int k = 0; k <= N_; ++k) x.col(k) = point(c, c.sA + L * k / N_);
+    // With compression, nodes at arc spacing L0 would start compressed (a chord is shorter than
+    // its arc by ~L0^3 kappa^2 / 24) and spring apart at the first step. Instead walk chords of
+    // exactly L0 along a catenary a little longer than L, its length found by the secant method
+    // so that the N-th chord ends on B. Kept as above if the walk fails (a hairpin U).
+    if (Has(kCompression)) {
+      // Arc coordinate reached beyond end B after N chords of L0 on the catenary of length Ls.
+      auto walk = [&](double Ls, bool store) -> double {
+        const Curve cs = solve(Ls);
+        double sk = cs.sA;
+        Vec3 P = A;
+        for (int k = 1; k <= N_; ++k) {
+          // Newton on |P(s) - P|^2 = L0^2, from one arc length L0 on (the chord is shorter).
+          double s = sk + L0_;
+          for (int it = 0; it < 50; ++it) {
+            const Vec3 d = point(cs, s) - P;
+            const double q = s / cs.a;
+            const Vec3 tangent = (eh + q * up) / std::sqrt(1 + q * q);  // dP/ds
+            const double slope = 2 * d.dot(tangent);
+            if (!(slope > 0)) return NAN;
+            const double ds = (d.squaredNorm() - L0_ * L0_) / slope;
+            s -= ds;
+            if (std::abs(ds) <= 1e-14 * (std::abs(s) + L0_)) break;
+          }
+          sk = s;
+          P = point(cs, sk);
+          if (store) x.col(k) = P;
+        }
+        return sk - (cs.sA + Ls);
+      };
+      double L1 = L, f1 = walk(L1, false);
+      double L2 = L + f1, f2 = walk(L2, false);
+      for (int it = 0; it < 50 && std::isfinite(f2) && std::abs(f2) > 1e-13 * L && f2 != f1;
+           ++it) {
+        const double L3 = L2 - f2 * (L2 - L1) / (f2 - f1);
+        L1 = L2;
+        f1 = f2;
+        L2 = L3;
+        f2 = walk(L2, false);
+      }
+      if (std::isfinite(f2) && std::abs(f2) <= 1e-9 * L) walk(L2, true);
     }
     x.col(N_) = B;  // remove round-off at the far end
   }
@@ -317,10 +373,19 @@ void Tether::SegmentGeometry(ConstNodes x, Nodes t, double* l) const {
 
 // Axial: T_j = EA eps_j + damping deps_j/dt, eps_j = l_j/L0 - 1, zero when slack (eps <= 0)
 // and never negative (Buckham et al. 2003, eq. for the viscoelastic segment).
+//
+// With the compression effect (EAc declared) a shortened segment pushes back instead, the way
+// OrcaFlex lets a line "allow compression": for eps < 0, T_j = min(0, EAc eps_j + damping
+// deps_j/dt) (the mirror of the taut law: damping never makes a shortened segment pull). This
+// is what keeps the segments of a bending tether at their length at zero tension, where the
+// bending shear would otherwise fold them (the Galerkin curvature below, Buckham & Nahon,
+// weighs with the rest length L0, so it presumes segments near it). T[j] reports the tension
+// only (>= 0); a compression is reported as 0, like slack.
 void Tether::AddAxial(ConstNodes x, ConstNodes v, ConstNodes t, const double* l, double* T,
                       Nodes f) const {
   (void)x;
   const bool damped = Has(kDamping);
+  const bool compression = Has(kCompression);
   const double inv_L0 = 1 / L0_, c = p_.damping / L0_;  // [1/m], [N s/m]
   for (int j = 0; j < N_; ++j) {
     const double eps = l[j] * inv_L0 - 1;
@@ -329,8 +394,12 @@ void Tether::AddAxial(ConstNodes x, ConstNodes v, ConstNodes t, const double* l,
       Tj = p_.EA * eps;
       if (damped) Tj += c * t.col(j).dot(v.col(j + 1) - v.col(j));
       Tj = std::max(Tj, 0.0);
+    } else if (compression && eps < 0) {
+      Tj = p_.EAc * eps;
+      if (damped) Tj += c * t.col(j).dot(v.col(j + 1) - v.col(j));
+      Tj = std::min(Tj, 0.0);
     }
-    T[j] = Tj;
+    T[j] = std::max(Tj, 0.0);
     f.col(j) += Tj * t.col(j);
     f.col(j + 1) -= Tj * t.col(j);
   }
@@ -514,6 +583,7 @@ EndReactions Tether::Reactions(const double* xp, const double* vp, const Ends& e
   return r;
 }
 
+// Tension only: a compressed segment (compression effect) reads 0, like a slack one.
 void Tether::Tensions(const double* xp, const double* vp, double* T) const {
   ConstNodes x(xp, 3, N_ + 1), v(vp, 3, N_ + 1);
   for (int j = 0; j < N_; ++j) {
@@ -552,6 +622,7 @@ double Tether::PotentialEnergy(const double* xp, const Ends& ends) const {
     Vec3 dx = x.col(j + 1) - x.col(j);
     const double l = dx.norm();
     if (Has(kAxial) && l > L0_) E += 0.5 * p_.EA / L0_ * (l - L0_) * (l - L0_);
+    if (Has(kCompression) && l < L0_) E += 0.5 * p_.EAc / L0_ * (l - L0_) * (l - L0_);
     Vec3 t = l > 0 ? Vec3(dx / l) : Vec3::Zero();
     // Bending: the potential of the forces of AddBending is EI/w (1 - cos theta) per node
     // (theta the turning angle, w the curvature weight), since M = EI sin(theta)/w.
@@ -725,15 +796,28 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
     // Axial stiffness and damping of taut segments: B = h D + h^2 K with
     // K = EA/L0 t t^T + T/l (I - t t^T), D = damping/L0 t t^T; +B on both diagonal blocks,
     // -B on the coupling block.
+    // A compressed segment (compression effect, 0 < l < L0) adds h^2 EAc/L0 t t^T and its
+    // damping while it pushes, without the geometric term -|T|/l (I - t t^T): that negative
+    // stiffness (buckling) would make the matrix indefinite, and bending carries it instead.
     if (Has(kAxial)) {
       const double ka = p_.EA / L0_;
+      const double kc = p_.EAc / L0_;
       const double ca = Has(kDamping) ? p_.damping / L0_ : 0;
+      const bool compression = Has(kCompression);
       for (int j = 0; j < N_; ++j) {
-        if (!(w.l[j] > L0_)) continue;
+        const bool taut = w.l[j] > L0_;
+        if (!taut && !(compression && w.l[j] > 0 && w.l[j] < L0_)) continue;
         const Vec3 tj = t.col(j);
-        const double geo = h2 * w.T[j] / w.l[j];
-        const double along = h2 * ka + (w.T[j] > 0 ? h * ca : 0) - geo;
-        const Mat3 B = along * tj * tj.transpose() + geo * I;
+        Mat3 B;
+        if (taut) {
+          const double geo = h2 * w.T[j] / w.l[j];
+          const double along = h2 * ka + (w.T[j] > 0 ? h * ca : 0) - geo;
+          B = along * tj * tj.transpose() + geo * I;
+        } else {
+          const double rate = tj.dot(vk.col(j + 1) - vk.col(j)) / L0_;  // [1/s] deps/dt
+          const bool pushes = p_.EAc * (w.l[j] / L0_ - 1) + ca * L0_ * rate < 0;
+          B = (h2 * kc + (pushes ? h * ca : 0)) * tj * tj.transpose();
+        }
         const bool d0 = Dynamic(j), d1 = Dynamic(j + 1);
         if (d0) A.D(j - 1) += B;
         if (d1) A.D(j) += B;
@@ -809,7 +893,8 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
     }
     A.Solve(w.rhs);
     for (int i = 1; i <= nu; ++i) vk.col(i) += rhs.col(i - 1);
-    // Did a segment change between slack and taut? Then the linearisation was wrong there.
+    // Did a segment change between slack (or compressed) and taut? Then the linearisation was
+    // wrong there: the law changes at l = L0 (from nothing or EAc to EA).
     place();
     bool changed = false;
     const double L0sq = L0_ * L0_;
@@ -960,7 +1045,8 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
 }
 
 // The most energy the tether can hold without diverging [J]: elastic energy at max_strain
-// along its whole length, ½ EA max_strain² L; bending energy of a fold at every node,
+// along its whole length, ½ EA max_strain² L; with compression, every segment shortened to
+// nothing, ½ EAc L; bending energy of a fold at every node,
 // ½ EI (2/L0)² L; the kinetic energy of the whole tether (with added mass) moving with its
 // fastest end plus the current; and the work of its net weight falling its own length.
 double Tether::EnergyBound(const Ends& from, const Ends& to) const {
@@ -971,6 +1057,7 @@ double Tether::EnergyBound(const Ends& from, const Ends& to) const {
   const double M = mass_.sum() + added_.sum();
   double E = 0.5 * p_.EA * p_.max_strain * p_.max_strain * L + 0.5 * M * v * v;
   if (Has(kBending)) E += 0.5 * p_.EI * (4 / (L0_ * L0_)) * L;
+  if (Has(kCompression)) E += 0.5 * p_.EAc * L;
   double W = 0;  // [N] net weight, without sign
   for (int i = 0; i <= N_; ++i) W += weight_.col(i).norm();
   return E + W * L;

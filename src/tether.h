@@ -95,8 +95,8 @@ class Tether {
   StepStatus Advance(double* x, double* v, const Ends& from, const Ends& to, double dt,
                      double* work) const;
 
-  // Forces on every node f (3 x n) [N], and segment tensions T (N) [N] when T is not null,
-  // from the state as it is (ends as stored in x, v).
+  // Forces on every node f (3 x n) [N], and segment tensions T (N) [N], >= 0 (a compression
+  // reads 0), when T is not null, from the state as it is (ends as stored in x, v).
   void ComputeForces(const double* x, const double* v, const Ends& ends, double* f, double* T,
                      double* work) const;
 
@@ -105,11 +105,12 @@ class Tether {
   EndReactions Reactions(const double* x, const double* v, const Ends& ends,
                          double* work) const;
 
-  // Segment tensions T (N) [N] of the state as it is.
+  // Segment tensions T (N) [N] of the state as it is, >= 0 (slack or compressed: 0).
   void Tensions(const double* x, const double* v, double* T) const;
 
-  // Energies [J] for conservation checks: kinetic (with added mass), elastic (axial and
-  // bending) and gravitational (weight minus buoyancy, relative to z = 0).
+  // Energies [J] for conservation checks: kinetic (with added mass), elastic (axial, with
+  // compression when declared, and bending) and gravitational (weight minus buoyancy,
+  // relative to z = 0).
   double KineticEnergy(const double* x, const double* v) const;
   double PotentialEnergy(const double* x, const Ends& ends) const;
   // The most energy the tether can hold physically while its ends move from `from` to `to`

@@ -9,7 +9,7 @@ namespace {
 
 const char* kExample =
     "ends=tms_port,rov_attach length=40 segments=40\n"
-    "            diameter=0.02 mass_per_length=0.35 EA=2e5 EI=0.5 damping=50\n"
+    "            diameter=0.02 mass_per_length=0.35 EA=2e5 EAc=2e5 EI=0.5 damping=50\n"
     "            Cdn=1.2 Cdt=0.01 Can=1.0 integrator=implicit";
 
 Environment Wet() {
@@ -29,12 +29,13 @@ TEST(Declaration, ParsesTheDocumentedExample) {
   EXPECT_EQ(d->site_b, "rov_attach");
   EXPECT_EQ(d->params.segments, 40);
   EXPECT_DOUBLE_EQ(d->params.EA, 2e5);
+  EXPECT_DOUBLE_EQ(d->params.EAc, 2e5);
   EXPECT_DOUBLE_EQ(d->params.EI, 0.5);
   EXPECT_DOUBLE_EQ(d->params.Can, 1.0);
   EXPECT_EQ(d->params.integrator, Integrator::kImplicit);
   // Every effect the declaration calls for, and no clamp.
   EXPECT_EQ(EffectsToString(d->params.effects),
-            "axial,damping,bending,weight,buoyancy,drag,added_mass,current,seabed");
+            "axial,damping,bending,weight,buoyancy,drag,added_mass,current,seabed,compression");
 }
 
 TEST(Declaration, DryScenesHaveNoHydrodynamics) {
@@ -42,7 +43,7 @@ TEST(Declaration, DryScenesHaveNoHydrodynamics) {
   Environment dry;
   std::optional<TetherDeclaration> d = ParseTether(kExample, dry, &e);
   ASSERT_TRUE(d) << e.message;
-  EXPECT_EQ(EffectsToString(d->params.effects), "axial,damping,bending,weight");
+  EXPECT_EQ(EffectsToString(d->params.effects), "axial,damping,bending,weight,compression");
 }
 
 TEST(Declaration, ZeroCoefficientsTurnEffectsOff) {
@@ -88,6 +89,19 @@ std::string With(const std::string& replace, const std::string& by) {
   return s;
 }
 
+// EAc declares the compression effect (last in the list); without it there is none, and an
+// effects= list without 'compression' turns it off.
+TEST(Declaration, EAcTurnsCompressionOn) {
+  DeclarationError e;
+  std::optional<TetherDeclaration> d = ParseTether(With("EAc=2e5 ", ""), Environment(), &e);
+  ASSERT_TRUE(d) << e.message;
+  EXPECT_EQ(d->params.EAc, 0);
+  EXPECT_EQ(EffectsToString(d->params.effects), "axial,damping,bending,weight");
+  d = ParseTether(std::string(kExample) + " effects=axial,bending", Environment(), &e);
+  ASSERT_TRUE(d) << e.message;
+  EXPECT_EQ(d->params.effects, unsigned(kAxial | kBending));
+}
+
 INSTANTIATE_TEST_SUITE_P(
     Declaration, BadTether,
     ::testing::Values(
@@ -124,7 +138,15 @@ INSTANTIATE_TEST_SUITE_P(
                 "allowed"},
         BadCase{"effect without coefficient", With("EI=0.5", "EI=0") + " effects=axial,bending",
                 "effects", "EI > 0"},
-        BadCase{"no axial", std::string(kExample) + " effects=drag", "effects", "axial"}));
+        BadCase{"no axial", std::string(kExample) + " effects=drag", "effects", "axial"},
+        BadCase{"EAc not a number", With("EAc=2e5", "EAc=stiff"), "EAc",
+                "not a number"},
+        BadCase{"EAc NaN", With("EAc=2e5", "EAc=nan"), "EAc", "not a finite number"},
+        BadCase{"EAc zero", With("EAc=2e5", "EAc=0"), "EAc", "(0, 1e+13]"},
+        BadCase{"EAc negative", With("EAc=2e5", "EAc=-2e5"), "EAc", "(0, 1e+13]"},
+        BadCase{"EAc huge", With("EAc=2e5", "EAc=1e14"), "EAc", "(0, 1e+13]"},
+        BadCase{"compression without EAc", With("EAc=2e5 ", "") + " effects=axial,compression",
+                "effects", "EAc > 0"}));
 
 TEST(Declaration, MalformedTextIsRejected) {
   DeclarationError e;

@@ -1,5 +1,6 @@
 // Tests of the tether engine alone (no MuJoCo): closed forms, conservation laws.
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <vector>
 
@@ -105,17 +106,52 @@ TEST(InitialShape, SlackCatenaryHasDeclaredLength) {
   for (int i = 0; i <= 40; ++i) EXPECT_NEAR(s.node(i).dot(normal), 0, 1e-9);
 }
 
-TEST(InitialShape, VerticalEndsHangAU) {
+// With compression a segment shorter than L0 pushes, so the slack initial shape must not
+// start compressed: every chord is L0 (to 1e-9 relative; the walk converges to 1e-14), the
+// end nodes are on the sites, and the shape is the same catenary as without compression to
+// within the chord-versus-arc difference (the nodes move by less than 1% of L0 here).
+TEST(InitialShape, WithCompressionEveryChordIsTheRestLength) {
   Environment env;
-  Sim s(Make(CatenaryParams(20), env));
-  s.ends.a.pos = Vec3(0, 0, 0);
-  s.ends.b.pos = Vec3(0, 0, -10);
-  s.Init();
-  for (double xi : s.x) ASSERT_TRUE(std::isfinite(xi));
-  double lowest = 0;
-  for (int i = 0; i <= 20; ++i) lowest = std::min(lowest, s.node(i).z());
-  // A U of length 100 between points 10 m apart vertically bottoms out 55 m below A.
-  EXPECT_NEAR(lowest, -55, 2.5);  // the node spacing (5 m) limits how close a node gets
+  TetherParams p = CatenaryParams(40);
+  Sim plain(Make(p, env));
+  p.EAc = 1e5;
+  Sim s(Make(p, env));
+  for (Sim* t : {&plain, &s}) {
+    t->ends.a.pos = Vec3(0, 0, 0);
+    t->ends.b.pos = Vec3(60, 30, 20);
+    t->Init();
+  }
+  double worst = 0, moved = 0;
+  for (int i = 0; i < 40; ++i) {
+    worst = std::max(worst, std::abs((s.node(i + 1) - s.node(i)).norm() / 2.5 - 1));
+  }
+  for (int i = 0; i <= 40; ++i) moved = std::max(moved, (s.node(i) - plain.node(i)).norm());
+  std::printf("compressed start: chord error %.2e, moved %.3g m\n", worst, moved);
+  EXPECT_LT(worst, 1e-9);
+  EXPECT_EQ((s.node(0) - s.ends.a.pos).norm(), 0);
+  EXPECT_EQ((s.node(40) - s.ends.b.pos).norm(), 0);
+  EXPECT_LT(moved, 0.01 * 2.5);
+  const Vec3 normal = Vec3(60, 30, 0).cross(Vec3::UnitZ()).normalized();
+  for (int i = 0; i <= 40; ++i) EXPECT_NEAR(s.node(i).dot(normal), 0, 1e-9);
+}
+
+// (With compression too: the hairpin at the bottom is where the equal-chord walk may give up
+// and keep the arc spacing; either way the shape is finite and the same.)
+TEST(InitialShape, VerticalEndsHangAU) {
+  for (double EAc : {0.0, 1e5}) {
+    Environment env;
+    TetherParams p = CatenaryParams(20);
+    p.EAc = EAc;
+    Sim s(Make(p, env));
+    s.ends.a.pos = Vec3(0, 0, 0);
+    s.ends.b.pos = Vec3(0, 0, -10);
+    s.Init();
+    for (double xi : s.x) ASSERT_TRUE(std::isfinite(xi));
+    double lowest = 0;
+    for (int i = 0; i <= 20; ++i) lowest = std::min(lowest, s.node(i).z());
+    // A U of length 100 between points 10 m apart vertically bottoms out 55 m below A.
+    EXPECT_NEAR(lowest, -55, 2.5);  // the node spacing (5 m) limits how close a node gets
+  }
 }
 
 // Static elastic catenary between two fixed points against Irvine's closed form. The lumped
@@ -444,6 +480,158 @@ TEST(Rk4, FourthOrderInTime) {
   std::printf("symplectic Euler: errors %.3g %.3g m, order %.2f\n", s1, s2, std::log2(s1 / s2));
   EXPECT_LT(std::log2(s1 / s2), 1.5);
   EXPECT_GT(s1, 100 * e1);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Compression (EAc): a shortened segment pushes back with EAc (l/L0 - 1), plus damping while
+// it pushes; without EAc it carries nothing.
+
+// Two segments of rest length L0 = 1 m between sites 2 m apart, in air without gravity; the
+// middle node is moved along the line by `delta` [m].
+TetherParams SpringParams() {
+  TetherParams p;
+  p.length = 2;
+  p.segments = 2;
+  p.diameter = 0.02;
+  p.mass_per_length = 1;  // node mass 1 kg
+  p.EA = 1e4;
+  p.EAc = 3e3;  // different from EA, so that each law is seen
+  p.integrator = Integrator::kExplicit;
+  return p;
+}
+
+Environment NoGravity() {
+  Environment env;
+  env.gravity.setZero();
+  return env;
+}
+
+// The force on the middle node of a straight line, displaced by 1 cm towards B (segment 0
+// stretched, segment 1 shortened, both by 1%): EA eps pulls it back and EAc eps pushes it back,
+// exactly (-100 N - 30 N); without EAc only the taut segment acts (-100 N). Reported tensions
+// are the taut segment's 100 N and 0 for the compressed one (tension only). With damping, a
+// compressed segment that is shortening pushes harder (EAc eps + c deps/dt), and one that
+// lengthens fast enough to outrun its elastic push carries nothing (it never pulls).
+TEST(Compression, ForceIsEAcTimesStrainAndOnlyPushes) {
+  const Environment env = NoGravity();
+  Ends ends;
+  ends.b.pos = Vec3(2, 0, 0);
+  std::vector<double> x = {0, 0, 0, 1.01, 0, 0, 2, 0, 0}, v(9, 0.0), f(9), T(2);
+  for (bool declared : {true, false}) {
+    TetherParams p = SpringParams();
+    if (!declared) p.EAc = 0;
+    Tether t = Make(p, env);
+    EXPECT_EQ((t.params().effects & kCompression) != 0, declared);
+    std::vector<double> work(t.WorkspaceSize());
+    t.ComputeForces(x.data(), v.data(), ends, f.data(), T.data(), work.data());
+    const double expected = -1e4 * 0.01 - (declared ? 3e3 * 0.01 : 0);
+    EXPECT_NEAR(f[3], expected, 1e-9 * std::abs(expected)) << "declared " << declared;
+    EXPECT_NEAR(f[4], 0, 1e-12);
+    // Each end node receives its own segment's force: the pull of segment 0 on A, and the push
+    // of segment 1 on B (outwards, +x).
+    EXPECT_NEAR(f[0], 1e4 * 0.01, 1e-9);
+    EXPECT_NEAR(f[6], declared ? 3e3 * 0.01 : 0, 1e-9);
+    EXPECT_NEAR(T[0], 100, 1e-9);
+    EXPECT_EQ(T[1], 0);
+    t.Tensions(x.data(), v.data(), T.data());
+    EXPECT_EQ(T[1], 0);
+  }
+  TetherParams p = SpringParams();
+  p.damping = 50;  // [N s]
+  Tether t = Make(p, env);
+  std::vector<double> work(t.WorkspaceSize());
+  // Middle node moving towards B at 0.2 m/s: segment 1 shortens, deps/dt = -0.2 1/s.
+  v[3] = 0.2;
+  t.ComputeForces(x.data(), v.data(), ends, f.data(), nullptr, work.data());
+  EXPECT_NEAR(f[6], 3e3 * 0.01 + 50 * 0.2, 1e-9);
+  // Moving away from B at 1 m/s: EAc eps + c deps/dt = -30 + 50 > 0, so no force.
+  v[3] = -1;
+  t.ComputeForces(x.data(), v.data(), ends, f.data(), nullptr, work.data());
+  EXPECT_EQ(f[6], 0);
+}
+
+// The middle node oscillating along the line is a harmonic oscillator of stiffness
+// (EA + EAc)/L0 whatever the sign of its displacement (one segment is always stretched and the
+// other shortened by the same amount), so omega^2 = (EA + EAc)/(L0 m). Undamped, symplectic
+// Euler at h omega = 1.1e-3: the period within 1e-3 (its frequency error is (h omega)^2/24
+// and the zero crossings are timed to h / 20 periods) and the energy, elastic in both laws,
+// within 1e-3 of its start (the method conserves a modified energy that differs from the true
+// one by at most h omega / 2 = 5.7e-4 of it). Without compression the period would be
+// sqrt(1.3) = 1.14 times longer.
+TEST(Compression, UndampedSpringOscillationConservesEnergyAtTheAnalyticPeriod) {
+  TetherParams p = SpringParams();
+  const double omega = std::sqrt((p.EA + p.EAc) / (1.0 * 1.0));  // [rad/s]
+  p.max_step = 1e-5;
+  Sim s(Make(p, NoGravity()));
+  s.ends.b.pos = Vec3(2, 0, 0);
+  s.x = {0, 0, 0, 1.02, 0, 0, 2, 0, 0};
+  std::fill(s.v.begin(), s.v.end(), 0.0);
+  const double E0 = s.Energy();
+  EXPECT_NEAR(E0, 0.5 * (p.EA + p.EAc) * 0.02 * 0.02, 1e-12);
+  double dE = 0, first = -1, last = -1, prev = s.x[3] - 1;
+  int crossings = 0;
+  const double h = 1e-4;  // [s] per call: 10 substeps of max_step
+  for (int k = 1; k <= 12000; ++k) {
+    ASSERT_TRUE(s.Step(h).ok);
+    dE = std::max(dE, std::abs(s.Energy() - E0));
+    const double now = s.x[3] - 1;
+    if ((now > 0) != (prev > 0)) {
+      const double tc = (k - 1 + prev / (prev - now)) * h;
+      if (first < 0) first = tc;
+      last = tc;
+      ++crossings;
+    }
+    prev = now;
+  }
+  ASSERT_GE(crossings, 40);
+  const double period = 2 * (last - first) / (crossings - 1);
+  std::printf("compressed spring: period / analytic %.6f, max |dE| / E0 %.2e\n",
+              period * omega / (2 * M_PI), dE / E0);
+  EXPECT_NEAR(period * omega / (2 * M_PI), 1, 1e-3);
+  EXPECT_LT(dE, 1e-3 * E0);
+}
+
+// The implicit step carries the compressed segment's stiffness in its Jacobian: with EAc ten
+// times EA (so that a compression treated explicitly would blow up) and a step of 16 times
+// 1/omega (far beyond the explicit limit 2/omega) the oscillation stays bounded and its energy
+// never rises above the start (backward Euler only removes energy); the segments switch
+// between the laws in most steps, which the Newton iteration absorbs.
+TEST(Compression, ImplicitLargeStepNeverGainsEnergy) {
+  TetherParams p = SpringParams();
+  p.EAc = 1e5;
+  p.integrator = Integrator::kImplicit;
+  Sim s(Make(p, NoGravity()));
+  s.ends.b.pos = Vec3(2, 0, 0);
+  s.x = {0, 0, 0, 1.02, 0, 0, 2, 0, 0};
+  std::fill(s.v.begin(), s.v.end(), 0.0);
+  const double E0 = s.Energy();
+  for (int k = 0; k < 200; ++k) {
+    ASSERT_TRUE(s.Step(0.05).ok);
+    ASSERT_LE(s.Energy(), E0 * (1 + 1e-12)) << "step " << k;
+  }
+  EXPECT_LT(s.Energy(), 1e-3 * E0);
+}
+
+// The explicit stability limit takes the stiffer of the two laws: with EAc = 10 EA the
+// oscillator above (omega^2 = (EA + EAc)/(L0 m)) is stable at 0.9 times the advertised limit,
+// and diverges at the limit the tension law alone would give, 0.8 * 2 / sqrt(4 EA/(L0 m)),
+// which is 1.3 times its own 2/omega.
+TEST(Compression, ExplicitLimitUsesTheStifferLaw) {
+  TetherParams p = SpringParams();
+  p.EAc = 1e5;
+  const double limit = Make(p, NoGravity()).ExplicitStableStep();
+  const double tension_only = 0.8 * 2 / std::sqrt(4 * p.EA / (1.0 * 1.0));
+  EXPECT_NEAR(limit, 0.8 * 2 / std::sqrt(4 * p.EAc), 1e-12);
+  for (double step : {0.9 * limit, tension_only}) {
+    p.max_step = step;
+    Sim s(Make(p, NoGravity()));
+    s.ends.b.pos = Vec3(2, 0, 0);
+    s.x = {0, 0, 0, 1.02, 0, 0, 2, 0, 0};
+    std::fill(s.v.begin(), s.v.end(), 0.0);
+    bool ok = true;
+    for (int k = 0; k < 500 && ok; ++k) ok = s.Step(step).ok;
+    EXPECT_EQ(ok, step < tension_only) << "step " << step << ", limit " << limit;
+  }
 }
 
 }  // namespace

@@ -99,6 +99,27 @@ TEST_F(Scene, AdvisorCoversMaxStepAndIsSilentOtherwise) {
   EXPECT_TRUE(Warnings(implicit).empty());
 }
 
+// A tether with bending but no compression gets one warning naming the file, the tether and
+// the remedy (EAc), since its slack segments can shorten at zero tension; declaring EAc
+// silences it, and so does a tether without bending. The shipped default scene declares EAc
+// and loads without any warning.
+TEST_F(Scene, AdvisorWarnsAboutBendingWithoutCompression) {
+  mjModel* m = Load(LineXml("EI=0.1"), "bend.xml");
+  ASSERT_NE(m, nullptr);
+  ASSERT_EQ(Warnings(m).size(), 1u);
+  const std::string w = Warnings(m)[0];
+  EXPECT_TRUE(Contains(w, "bend.xml: <text name=\"tether:line\">")) << w;
+  EXPECT_TRUE(Contains(w, "EAc")) << w;
+  EXPECT_TRUE(Warnings(Load(LineXml("EI=0.1 EAc=1e6"))).empty());
+  EXPECT_TRUE(Warnings(Load(LineXml(""))).empty());
+  std::ifstream f(std::string(MJTETHER_MODELS_DIR) + "/rov_tether.xml");
+  std::stringstream xml;
+  xml << f.rdbuf();
+  mjModel* scene = Load(xml.str(), "rov_tether.xml");
+  ASSERT_NE(scene, nullptr);
+  EXPECT_EQ(Warnings(scene).size(), 0u);
+}
+
 // An explicit tether that would need more than 1e5 substeps per MuJoCo step is refused at
 // load time with the count and what to change (it would otherwise run for hours).
 TEST_F(Scene, AbsurdAutomaticSubstepsAreRefused) {
@@ -238,6 +259,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"negative", kGoodWater, BadTether("damping=5", "damping=-5"), "tether:u",
                  "damping", "[0, 1e+12]"},
         BadInput{"zero", kGoodWater, BadTether("EA=1e5", "EA=0"), "tether:u", "EA", "(0, 1e+13]"},
+        BadInput{"negative_EAc", kGoodWater, std::string(kGoodTether) + " EAc=-1e5", "tether:u",
+                 "EAc", "(0, 1e+13]"},
         BadInput{"huge_segments", kGoodWater, BadTether("segments=10", "segments=1e9"), "tether:u",
                  "segments", "[1, 100000]"},
         BadInput{"fractional_segments", kGoodWater, BadTether("segments=10", "segments=10.5"),

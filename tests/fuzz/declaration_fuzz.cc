@@ -40,6 +40,8 @@ void CheckTether(const TetherDeclaration& d, const Environment& env) {
   Check(p.mass_per_length > 0 && p.mass_per_length <= 1e5);
   Check(p.EA > 0 && p.EA <= 1e13);
   Check(p.EI >= 0 && p.EI <= 1e12);
+  Check(p.EAc >= 0 && p.EAc <= 1e13);  // 0: not declared
+  Check(((p.effects & kCompression) == 0) || p.EAc > 0);
   Check(p.damping >= 0 && p.damping <= 1e12);
   Check(p.Cdn >= 0 && p.Cdn <= 100 && p.Cdt >= 0 && p.Cdt <= 100 && p.Can >= 0 && p.Can <= 100);
   Check(p.substeps >= 0 && p.substeps <= 100000);
