@@ -92,7 +92,7 @@ struct Sim {
 class Integrators : public ::testing::TestWithParam<Integrator> {};
 
 std::string IntegratorName(const ::testing::TestParamInfo<Integrator>& info) {
-  return info.param == Integrator::kExplicit ? "explicit" : "implicit";
+  return mjtether::IntegratorName(info.param);
 }
 
 Environment Water(const Vec3& current = Vec3::Zero()) {
@@ -493,7 +493,7 @@ TEST_P(Integrators, SeabedSlamEndsRestingOnTheSeabed) {
       "slam: E0 %.4g Emax-E0 %.3g, pen max %.4g (bound %.4g), rest error %.3g (w/k "
       "%.3g), v %.2e\n",
       E0, E_max - E0, pen_max, pen_bound, worst, w / k, s.MaxSpeed());
-  EXPECT_LE(E_max - E0, (GetParam() == Integrator::kExplicit ? 0.01 : 1e-9) * std::abs(E0));
+  EXPECT_LE(E_max - E0, (IsExplicit(GetParam()) ? 0.01 : 1e-9) * std::abs(E0));
   EXPECT_LT(pen_max, pen_bound);
   EXPECT_LT(worst, 0.1 * w / k);
   EXPECT_LT(s.MaxSpeed(), 0.01);
@@ -541,9 +541,7 @@ TEST_P(Integrators, CoincidentNodesUnfoldIntoADoubledStrand) {
 // A loaded model and its data, released at the end of the scope.
 using Model = testing::LoadedScene;
 
-const char* Name(Integrator integrator) {
-  return integrator == Integrator::kExplicit ? "explicit" : "implicit";
-}
+const char* Name(Integrator integrator) { return mjtether::IntegratorName(integrator); }
 
 // Snap load: a 500 kg vehicle coasting at 3 m/s (no gravity, no water) on a slack 20 m tether
 // of 10 kg jerks it taut. Energy balance for a massless spring: the vehicle's kinetic energy
@@ -571,7 +569,7 @@ class SnapLoad : public ::testing::TestWithParam<std::tuple<double, Integrator>>
 
 TEST_P(SnapLoad, PeakTensionMatchesEnergyBalance) {
   const double EA = std::get<0>(GetParam()), M = 500, v = 3, L = 20;
-  const bool ringing = EA > 1e7 && std::get<1>(GetParam()) == Integrator::kExplicit;
+  const bool ringing = EA > 1e7 && IsExplicit(std::get<1>(GetParam()));
   std::ostringstream xml;
   xml << R"(<mujoco><option timestep=")" << (ringing ? 2e-5 : 0.002)
       << R"(" gravity="0 0 0"/><custom>
@@ -609,7 +607,8 @@ TEST_P(SnapLoad, PeakTensionMatchesEnergyBalance) {
 INSTANTIATE_TEST_SUITE_P(Stress, SnapLoad,
                          ::testing::Combine(::testing::Values(1e4, 1e6, 1e8),
                                             ::testing::Values(Integrator::kImplicit,
-                                                              Integrator::kExplicit)));
+                                                              Integrator::kExplicit,
+                                                              Integrator::kRK4)));
 
 // A vehicle (mocap body, moved by the test) with the tether 0.5 m off its axis, in water with
 // a heavy tether hanging 8 m from a fixed TMS. After settling it spins at 2 rev/s (the end at
@@ -702,7 +701,8 @@ TEST_P(Integrators, TeleportedVehicleRecovers) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Stress, Integrators,
-                         ::testing::Values(Integrator::kImplicit, Integrator::kExplicit),
+                         ::testing::Values(Integrator::kImplicit, Integrator::kExplicit,
+                                           Integrator::kRK4),
                          IntegratorName);
 
 }  // namespace

@@ -66,7 +66,7 @@ void TetherStep(benchmark::State& state, std::string declaration, bool wet) {
   }
   std::string error;
   std::optional<Tether> t = Tether::Create(d->params, env, &error);
-  const bool explicit_scheme = d->params.integrator == Integrator::kExplicit;
+  const bool explicit_scheme = IsExplicit(d->params.integrator);
   const double h = explicit_scheme ? 0.9 * t->ExplicitStableStep() : 0.002;
   std::vector<double> x(3 * t->nodes()), v(3 * t->nodes()), work(t->WorkspaceSize());
   Ends ends;
@@ -125,7 +125,7 @@ int main(int argc, char** argv) {
   using namespace mjtether;
   const std::vector<std::string> effects = {"damping", "bending",    "weight",  "buoyancy",
                                             "drag",    "added_mass", "current", "seabed"};
-  for (const char* integrator : {"explicit", "implicit", "implicit2"}) {
+  for (const char* integrator : {"explicit", "rk4", "implicit", "implicit2"}) {
     const std::string scheme = std::string(" integrator=") + integrator;
     std::vector<std::pair<std::string, std::pair<std::string, bool>>> cases;
     cases.push_back({"all", {std::string(kCoefficients) + " effects=" + kAll + scheme, true}});
