@@ -27,7 +27,7 @@ set yrange [0.004:1e3]
 set key bottom left box opaque
 stats file("line_mean") using 1 nooutput
 meanT = STATS_min
-set title sprintf("all segment counts (10-80) against 160 segments converged; mean tension %.0f N", meanT)
+set title sprintf("all segment counts (10-160) against 320 segments converged; mean tension %.0f N", meanT)
 set label 1 "1%" at graph 0.01, first 0.01 * meanT left offset 0,0.6 front
 set arrow 1 from graph 0, first 0.01 * meanT to graph 1, first 0.01 * meanT nohead dt 3 lc rgb "#888888"
 set label 2 "0.1%" at graph 0.01, first 0.001 * meanT left offset 0,0.6 front
@@ -44,7 +44,7 @@ unset label 2
 unset arrow 2
 set title "80 segments: time error only (against 80 segments converged in time)"
 set ylabel "end tension error, time discretisation only [N]"
-set yrange [1e-3:1e3]
+set yrange [1e-4:1e3]
 set key top right box opaque
 set object 1 rect from graph 0, first 1e-9 to first 6, first 0.02 fc rgb "#2ca02c" fs transparent solid 0.12 noborder
 set object 2 rect from graph 0, first 1e-9 to first 3, first 6 fc rgb "#1f77b4" fs transparent solid 0.08 noborder

@@ -1,4 +1,4 @@
-// Cost of the passive callback per MuJoCo step, for 10-200 segments, both integrators:
+// Cost of the passive callback per MuJoCo step, for 10-200 segments, each integrator:
 // a tether between a fixed site and a free body in a current (the default scene's
 // physics), stepped with mj_step. Reports time per step and per node-step.
 //
@@ -74,10 +74,12 @@ void Step(benchmark::State& state, const char* integrator, bool tether) {
 
 void BM_StepImplicit(benchmark::State& s) { Step(s, "implicit", true); }
 void BM_StepExplicit(benchmark::State& s) { Step(s, "explicit", true); }
+void BM_StepRk4(benchmark::State& s) { Step(s, "rk4", true); }
 void BM_StepNoTether(benchmark::State& s) { Step(s, "implicit", false); }
 
 BENCHMARK(BM_StepImplicit)->Arg(10)->Arg(20)->Arg(50)->Arg(100)->Arg(200);
 BENCHMARK(BM_StepExplicit)->Arg(10)->Arg(20)->Arg(50)->Arg(100)->Arg(200);
+BENCHMARK(BM_StepRk4)->Arg(10)->Arg(20)->Arg(50)->Arg(100)->Arg(200);
 BENCHMARK(BM_StepNoTether)->Arg(10);
 
 }  // namespace
