@@ -329,6 +329,22 @@ TEST(Energy, ImplicitUndampedSwingNeverGainsEnergy) {
   EXPECT_LT(E_prev, E0);
 }
 
+// The catenary of p between (0,0,0) and (80,0,20), from its initial shape, stepped 400
+// times by `call` [s] in tether steps of `step` [s]; false if Advance reported divergence.
+// The final positions go to *x when given.
+bool CatenaryRunsAt(TetherParams p, const Environment& env, double step, double call,
+                    std::vector<double>* x) {
+  p.max_step = step;
+  Sim s(Make(p, env));
+  s.ends.a.pos = Vec3(0, 0, 0);
+  s.ends.b.pos = Vec3(80, 0, 20);
+  s.Init();
+  bool ok = true;
+  for (int k = 0; k < 400 && ok; ++k) ok = s.Step(call).ok;
+  if (x) *x = s.x;
+  return ok;
+}
+
 // The explicit stability limit is real: stepping at 0.9x the advertised limit is stable and
 // at 3x it blows up, which the divergence check reports.
 TEST(Stability, ExplicitLimitSeparatesStableFromUnstable) {
@@ -338,14 +354,7 @@ TEST(Stability, ExplicitLimitSeparatesStableFromUnstable) {
   Tether t = Make(p, env);
   const double limit = t.ExplicitStableStep();
   for (double factor : {0.9, 3.0}) {
-    TetherParams q = p;
-    q.max_step = factor * limit;
-    Sim s(Make(q, env));
-    s.ends.a.pos = Vec3(0, 0, 0);
-    s.ends.b.pos = Vec3(80, 0, 20);
-    s.Init();
-    bool ok = true;
-    for (int k = 0; k < 400 && ok; ++k) ok = s.Step(20 * factor * limit).ok;
+    const bool ok = CatenaryRunsAt(p, env, factor * limit, 20 * factor * limit, nullptr);
     EXPECT_EQ(ok, factor < 1) << "factor " << factor << ", limit " << limit;
   }
 }
@@ -419,16 +428,9 @@ TEST(Stability, Rk4LimitSeparatesStableFromUnstable) {
     std::vector<double> positions[2];
     for (double factor : {0.9, 1.5, 0.1}) {
       if (damping > 0 ? factor == 1.5 : factor == 0.1) continue;
-      TetherParams q = p;
-      q.max_step = factor * limit;
-      Sim s(Make(q, env));
-      s.ends.a.pos = Vec3(0, 0, 0);
-      s.ends.b.pos = Vec3(80, 0, 20);
-      s.Init();
-      bool ok = true;
-      for (int k = 0; k < 400 && ok; ++k) ok = s.Step(18 * limit).ok;
+      const bool ok =
+          CatenaryRunsAt(p, env, factor * limit, 18 * limit, &positions[factor < 0.5]);
       EXPECT_EQ(ok, factor < 1) << "factor " << factor << ", limit " << limit;
-      positions[factor < 0.5] = s.x;
     }
     if (damping > 0) {
       double e = 0;
