@@ -95,7 +95,12 @@ EndState SiteState(const mjModel* m, const mjData* d, const AttachedTether& at, 
   } else if (at.mocap[end]) {
     const double h2 = d->time - u[kTime], h1 = u[kTime] - u[kPrevTime];
     const Vec3 p1(stored), p0(u + (end == 0 ? kPrevPosA : kPrevPosB));
-    if (u[kInitialized] != 0 && h2 > 0 && h1 > 0) {
+    if (u[kInitialized] != 0 && h2 > 0 && e.pos == p1) {
+      // Not moved since the last call: MuJoCo's own RK4 calls at t + h/2 and t + h with the
+      // mocap body where it was at t (it moves only between steps); the three-point formula
+      // would read that pause as a reversal.
+      e.vel = Vec3::Zero();
+    } else if (u[kInitialized] != 0 && h2 > 0 && h1 > 0) {
       e.vel = e.pos * ((2 * h2 + h1) / (h2 * (h1 + h2))) - p1 * ((h1 + h2) / (h1 * h2)) +
               p0 * (h2 / (h1 * (h1 + h2)));
     } else if (u[kInitialized] != 0 && h2 > 0) {

@@ -231,6 +231,31 @@ TEST_F(MuJoCoTest, MocapEndVelocityIsSecondOrder) {
   EXPECT_NEAR(std::log2(e1 / e2), 2, 0.3);
 }
 
+// MuJoCo's RK4 evaluates the passive force at t + h/2 and t + h with a mocap body still where
+// it was at t (mocap bodies move only between steps). A call that finds the mocap end where
+// the last call left it takes its velocity as zero, as the position says, rather than reading
+// the pause after a motion as a reversal (the three-point formula gives -v/3 there).
+TEST_F(MuJoCoTest, MocapEndPausedWithinAStepHasZeroVelocity) {
+  mjModel* m = Load(R"(<mujoco><option timestep="0.002" gravity="0 0 0"/><custom>
+      <text name="tether:t" data="ends=anchor,end length=10 segments=10 diameter=0.02
+            mass_per_length=0.3 EA=1e4"/></custom>
+      <worldbody><site name="anchor"/>
+        <body name="ship" mocap="true" pos="9 0 0"><site name="end"/></body>
+      </worldbody></mujoco>)");
+  mjData* d = Make(m);
+  const int N = GetTether(m, 0)->segments();
+  for (int k = 0; k < 10; ++k) {  // moving at 0.5 m/s: the end's velocity is 0.5
+    d->mocap_pos[0] = 9 + 0.5 * d->time;
+    mj_step(m, d);
+  }
+  d->mocap_pos[0] = 9 + 0.5 * d->time;
+  mj_forward(m, d);
+  EXPECT_NEAR(NodeVelocities(m, d, 0)[3 * N], 0.5, 1e-9);
+  d->time += 0.001;  // an RK4 stage: same mocap position, later time
+  mj_forward(m, d);
+  EXPECT_EQ(NodeVelocities(m, d, 0)[3 * N], 0.0);
+}
+
 // Going back in time (the user rewinds d->time) starts again from the initial shape.
 TEST_F(MuJoCoTest, EarlierTimeReinitialises) {
   mjModel* m = Load(DefaultModel());
