@@ -27,7 +27,7 @@ set yrange [0.004:1e3]
 set key bottom left box opaque
 stats file("line_mean") using 1 nooutput
 meanT = STATS_min
-set title sprintf("all segment counts (10-160) against 320 segments converged; mean tension %.0f N", meanT)
+set title sprintf("all segment counts (10-320) against 640 segments converged; mean tension %.0f N", meanT)
 set label 1 "1%" at graph 0.01, first 0.01 * meanT left offset 0,0.6 front
 set arrow 1 from graph 0, first 0.01 * meanT to graph 1, first 0.01 * meanT nohead dt 3 lc rgb "#888888"
 set label 2 "0.1%" at graph 0.01, first 0.001 * meanT left offset 0,0.6 front

@@ -7,7 +7,7 @@
 #   accuracy_cost.md    the same as markdown tables, one per scene
 #   accuracy_cost_line.png, accuracy_cost_scenes.png   the charts shown in README.md
 #   machine.txt         where and when it was measured
-# About 4 minutes on the 2-core machine. Usage:
+# About 11 minutes on the 2-core machine (5 of them the 640-segment reference of the line). Usage:
 #   tools/accuracy_cost.sh [BUILD_DIR] [driver options, e.g. --scenes line]
 #   tools/accuracy_cost.sh --plot-only      (charts again from the committed CSV)
 set -euo pipefail
