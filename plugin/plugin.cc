@@ -242,6 +242,14 @@ const double* UserBlock(const mjModel* m, const mjData* d, int k) {
 // MuJoCo step is an error. Implicit tethers need no advice.
 bool Advise(const Tether& t, double timestep, std::string* warning, std::string* error) {
   const TetherParams& p = t.params();
+  if (p.max_step > 0 && t.SubstepsFor(timestep) > kMaxAutoSubsteps) {
+    std::ostringstream s;
+    s << "key 'max_step' = " << p.max_step << " s gives " << std::ceil(timestep / p.max_step)
+      << " tether steps per MuJoCo step (<option timestep> " << timestep << " s), more than "
+      << kMaxAutoSubsteps << ": set max_step >= " << timestep / kMaxAutoSubsteps << " s";
+    *error = s.str();
+    return false;
+  }
   if (!IsExplicit(p.integrator)) return true;
   const char* name = IntegratorName(p.integrator);
   const double limit = t.ExplicitStableStep();

@@ -235,9 +235,10 @@ int Tether::WorkspaceSize() const {
 int Tether::SubstepsFor(double dt) const {
   if (!(dt > 0)) return 0;
   if (p_.substeps > 0) return p_.substeps;
-  if (p_.max_step > 0) return static_cast<int>(std::ceil(dt / p_.max_step - 1e-9));
-  if (!IsExplicit(p_.integrator)) return 1;
-  const double n = std::ceil(dt / explicit_dt_ - 1e-9);
+  if (!IsExplicit(p_.integrator) && !(p_.max_step > 0)) return 1;
+  // At most 1e9, so that the count fits an int whatever the step (a max_step of 1e-54 is
+  // in its range; the plugin refuses counts above 1e5 at load time).
+  const double n = std::ceil(dt / (p_.max_step > 0 ? p_.max_step : explicit_dt_) - 1e-9);
   return static_cast<int>(std::min(std::max(n, 1.0), 1e9));
 }
 

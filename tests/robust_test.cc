@@ -132,6 +132,21 @@ TEST_F(Scene, AbsurdAutomaticSubstepsAreRefused) {
   EXPECT_TRUE(Contains(error, "integrator=implicit")) << error;
 }
 
+// A max_step so small that one MuJoCo step would take more than 1e5 tether steps (it is within
+// the key's range (0, 1]) is refused the same way, for any integrator, instead of hanging the
+// first mj_step (found by the fuzzer: max_step=1e-54 also overflowed the step count).
+TEST_F(Scene, TinyMaxStepIsRefused) {
+  for (const char* integrator : {"implicit", "rk4"}) {
+    std::string error;
+    mjModel* m = LoadModelFromString(
+        LineXml(std::string("integrator=") + integrator + " max_step=1e-54"), "tiny.xml", &error);
+    ASSERT_EQ(m, nullptr) << integrator;
+    EXPECT_TRUE(Contains(error, "tiny.xml: <text name=\"tether:line\">")) << error;
+    EXPECT_TRUE(Contains(error, "'max_step'")) << error;
+    EXPECT_TRUE(Contains(error, "more than 100000")) << error;
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Divergence at run time
 

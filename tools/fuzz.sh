@@ -22,6 +22,8 @@ done
 printf '%s' 'ends=a,b length=40 segments=40 diameter=0.02 mass_per_length=0.35 EA=2e5 EAc=2e5 EI=0.5 damping=50 Cdn=1.2 Cdt=0.01 Can=1.0 integrator=explicit clamp=A effects=axial,bending,clamp,drag,compression substeps=3 max_strain=2' > "$out/corpus/tether_full"
 printf '%s' 'density=1025 current=0.3,0,0 seabed=-60 seabed_stiffness=1e5 seabed_damping=10 seabed_friction=0.5 seabed_friction_axial=0.2 seabed_friction_speed=0.01' > "$out/corpus/water_full"
 printf '%s' 'ends=a,b length=20 segments=20 diameter=0.02 mass_per_length=0.35 EA=2e5 integrator=rk4 max_step=1e-4' > "$out/corpus/tether_rk4"
+# Regression: a max_step this small overflowed the step count (found by this fuzzer).
+printf '%s' 'ends=a,b length=21 segments=19 diameter=0.02 mass_per_length=0.35 EA=2e5 integrator=rk4 max_step=1e-54' > "$out/corpus/tether_tiny_max_step"
 printf '%s' 'ends=a,free length=1e5 segments=1e5 diameter=10 mass_per_length=1e5 EA=1e13 EAc=1e13 EI=1e12 max_step=1' > "$out/corpus/tether_extremes"
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
   "$out/declaration_fuzz" -max_total_time="$seconds" -timeout=5 -rss_limit_mb=2048 \
