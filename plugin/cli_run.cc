@@ -182,7 +182,8 @@ int Info(const std::string& path) {
               << " segments of " << t->rest_segment_length() << " m, "
               << mjtether::IntegratorName(p.integrator)
               << ", effects " << mjtether::EffectsToString(p.effects) << "\n"
-              << "    explicit stable step " << t->ExplicitStableStep() << " s; "
+              << "    " << (p.integrator == mjtether::Integrator::kRK4 ? "rk4" : "explicit")
+              << " stable step " << t->ExplicitStableStep() << " s; "
               << t->SubstepsFor(m->opt.timestep) << " tether step(s) per MuJoCo step\n";
   }
   // Vehicles: net buoyancy and how the added mass is split (README, Vehicles).
