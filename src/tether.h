@@ -135,6 +135,7 @@ class Tether {
   void AddSeabed(ConstNodes x, ConstNodes v, ConstNodes q, Nodes f) const;
 
   // Integrators (one step of size h; ends already set at the start, `next` at the end).
+  void PlaceEnds(const Ends& e, Nodes x, Nodes v) const;
   Vec3 Acceleration(int i, const Vec3& fi, const Vec3& qi) const;
   void ExplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
                     double* work) const;
