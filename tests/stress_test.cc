@@ -237,7 +237,7 @@ TEST(Stress, ZeroTensionLoopIsTheSameWithBothIntegrators) {
 }
 
 // Without bending nothing resists folding: a rope pushed from its ends piles up. Its segments
-// keep at least half their rest length (measured 0.79-0.89 L0) and the total length stays
+// keep at least half their rest length (measured 0.81-0.89 L0) and the total length stays
 // within 2% of L (no segment collapses, none stretches: no tension builds up, < 0.01 N), the
 // pile does not collapse onto the chord (nodes stand out at least L/50 from it; measured
 // 0.29 m), the energy never rises after the ends stop (1e-6 J of round-off), and it does not
