@@ -157,6 +157,7 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
   c.added_ = c.Has(kAddedMass) ? Eigen::VectorXd(params.Can * rho * c.area_ * c.share_)
                                : Eigen::VectorXd::Zero(n);
   c.inv_mass_ = c.mass_.cwiseInverse();
+  c.damping_per_L0_ = params.damping / c.L0_;
   c.inv_mass_normal_ = (c.mass_ + c.added_).cwiseInverse();
   // Net weight: dry weight minus buoyancy of the displaced volume.
   c.weight_ = Eigen::Matrix3Xd::Zero(3, n);
@@ -382,24 +383,23 @@ void Tether::SegmentGeometry(ConstNodes x, Nodes t, double* l) const {
 // bending shear would otherwise fold them (the Galerkin curvature below, Buckham & Nahon,
 // weighs with the rest length L0, so it presumes segments near it). T[j] reports the tension
 // only (>= 0); a compression is reported as 0, like slack.
+// The law of one segment, from its strain eps, unit tangent t and the velocity difference dv of
+// its ends: EA eps + (damping/L0) t.dv, never negative, when stretched; EAc eps + the same
+// damping, never positive, when shortened with the compression effect; else 0.
+inline double Tether::AxialForce(double eps, const Vec3& t, const Vec3& dv) const {
+  const bool taut = eps > 0;
+  if (!taut && !(eps < 0 && Has(kCompression))) return 0;
+  double T = (taut ? p_.EA : p_.EAc) * eps;
+  if (Has(kDamping)) T += damping_per_L0_ * t.dot(dv);
+  return taut ? std::max(T, 0.0) : std::min(T, 0.0);
+}
+
 void Tether::AddAxial(ConstNodes x, ConstNodes v, ConstNodes t, const double* l, double* T,
                       Nodes f) const {
   (void)x;
-  const bool damped = Has(kDamping);
-  const bool compression = Has(kCompression);
-  const double inv_L0 = 1 / L0_, c = p_.damping / L0_;  // [1/m], [N s/m]
+  const double inv_L0 = 1 / L0_;  // [1/m]
   for (int j = 0; j < N_; ++j) {
-    const double eps = l[j] * inv_L0 - 1;
-    double Tj = 0;
-    if (eps > 0) {
-      Tj = p_.EA * eps;
-      if (damped) Tj += c * t.col(j).dot(v.col(j + 1) - v.col(j));
-      Tj = std::max(Tj, 0.0);
-    } else if (compression && eps < 0) {
-      Tj = p_.EAc * eps;
-      if (damped) Tj += c * t.col(j).dot(v.col(j + 1) - v.col(j));
-      Tj = std::min(Tj, 0.0);
-    }
+    const double Tj = AxialForce(l[j] * inv_L0 - 1, t.col(j), v.col(j + 1) - v.col(j));
     T[j] = std::max(Tj, 0.0);
     f.col(j) += Tj * t.col(j);
     f.col(j + 1) -= Tj * t.col(j);
@@ -587,15 +587,13 @@ EndReactions Tether::Reactions(const double* xp, const double* vp, const Ends& e
 // Tension only: a compressed segment (compression effect) reads 0, like a slack one.
 void Tether::Tensions(const double* xp, const double* vp, double* T) const {
   ConstNodes x(xp, 3, N_ + 1), v(vp, 3, N_ + 1);
+  const double inv_L0 = 1 / L0_;  // [1/m]
   for (int j = 0; j < N_; ++j) {
-    Vec3 dx = x.col(j + 1) - x.col(j);
+    const Vec3 dx = x.col(j + 1) - x.col(j);
     const double l = dx.norm();
-    const double eps = l / L0_ - 1;
     T[j] = 0;
-    if (eps > 0 && Has(kAxial)) {
-      T[j] = p_.EA * eps;
-      if (Has(kDamping)) T[j] += p_.damping * (dx / l).dot(v.col(j + 1) - v.col(j)) / L0_;
-      T[j] = std::max(T[j], 0.0);
+    if (Has(kAxial) && l > L0_) {
+      T[j] = AxialForce(l * inv_L0 - 1, dx * (1 / l), v.col(j + 1) - v.col(j));
     }
   }
 }

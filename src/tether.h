@@ -126,6 +126,7 @@ class Tether {
 
   // Per-effect terms; each adds to f (3 x n). See tether.cc for the equations.
   void SegmentGeometry(ConstNodes x, Nodes t, double* l) const;
+  double AxialForce(double eps, const Vec3& t, const Vec3& dv) const;
   void AddAxial(ConstNodes x, ConstNodes v, ConstNodes t, const double* l, double* T,
                 Nodes f) const;
   void BendingMoments(ConstNodes t, const Ends& ends, Nodes M) const;
@@ -161,6 +162,7 @@ class Tether {
   double explicit_dt_ = 0;      // [s]
   Eigen::VectorXd mass_;        // [kg] (n) dry lumped mass
   Eigen::VectorXd added_;       // [kg] (n) normal added mass Can rho A l_i
+  double damping_per_L0_ = 0;  // [N s/m] internal damping / rest segment length
   Eigen::VectorXd inv_mass_;          // [1/kg] (n) 1/m_i (multiplying is cheaper than dividing)
   Eigen::VectorXd inv_mass_normal_;   // [1/kg] (n) 1/(m_i + ma_i)
   Eigen::VectorXd share_;       // [m] (n) rest length lumped at each node
