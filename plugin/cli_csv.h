@@ -4,11 +4,23 @@
 #ifndef MJTETHER_PLUGIN_CLI_CSV_H_
 #define MJTETHER_PLUGIN_CLI_CSV_H_
 
+#include <cstdio>
+#include <cstdlib>
 #include <optional>
 #include <string>
 #include <vector>
 
 namespace mjtether::cli {
+
+// The shortest decimal that reads back as exactly v (at most 17 significant digits).
+inline std::string Shortest(double v) {
+  char buf[64];
+  for (int digits = 1; digits <= 17; ++digits) {
+    std::snprintf(buf, sizeof(buf), "%.*g", digits, v);
+    if (std::strtod(buf, nullptr) == v) break;
+  }
+  return buf;
+}
 
 // A field, quoted only when it needs to be.
 inline std::string CsvField(const std::string& s) {
@@ -32,8 +44,7 @@ struct CsvRecord {
 // Parses a whole file. Line ends LF or CRLF; empty lines are skipped; a quoted field may hold
 // line breaks. Returns nullopt with *error ("line L: ...") on a quote that is not closed or
 // text after a closing quote.
-inline std::optional<std::vector<CsvRecord>> ParseCsv(const std::string& text,
-                                                      std::string* error) {
+inline std::optional<std::vector<CsvRecord>> ParseCsv(const std::string& text, std::string* error) {
   std::vector<CsvRecord> records;
   CsvRecord record;
   std::string field;

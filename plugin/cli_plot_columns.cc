@@ -31,9 +31,8 @@ std::optional<Column> FindColumn(const std::vector<std::string>& header, const s
   if (!spec.empty() && spec.back() == ']') {
     const size_t open = spec.rfind('[');
     char* end = nullptr;
-    const long item = open == std::string::npos
-                          ? -1
-                          : std::strtol(spec.c_str() + open + 1, &end, 10);
+    const long item =
+        open == std::string::npos ? -1 : std::strtol(spec.c_str() + open + 1, &end, 10);
     if (open == std::string::npos || end != spec.c_str() + spec.size() - 1 || item < 0) {
       *error = "column '" + spec + "': expected NAME or NAME[i] with i >= 0";
       return std::nullopt;
@@ -106,8 +105,8 @@ int PlotColumns(const ColumnPlot& p) {
   for (size_t r = 1; r < records->size(); ++r) {
     const std::vector<std::string>& v = (*records)[r].fields;
     if (v.size() != header.size()) {
-      std::cerr << "mjtether: " << p.input << ": line " << (*records)[r].line << ": "
-                << v.size() << " fields, the header has " << header.size() << "\n";
+      std::cerr << "mjtether: " << p.input << ": line " << (*records)[r].line << ": " << v.size()
+                << " fields, the header has " << header.size() << "\n";
       return 2;
     }
     if (cstatus >= 0 && v[cstatus] != "ok") {
@@ -132,8 +131,8 @@ int PlotColumns(const ColumnPlot& p) {
     std::cerr << "mjtether: plot: left out " << skipped_status << " rows whose status is not ok\n";
   }
   if (skipped_number) {
-    std::cerr << "mjtether: plot: left out " << skipped_number
-              << " rows without a number in " << p.x << " or " << p.y << "\n";
+    std::cerr << "mjtether: plot: left out " << skipped_number << " rows without a number in "
+              << p.x << " or " << p.y << "\n";
   }
   if (series.empty()) {
     std::cerr << "mjtether: " << p.input << ": no rows with numbers in " << p.x << " and " << p.y
@@ -182,8 +181,8 @@ int PlotColumns(const ColumnPlot& p) {
   }
   size_t n = 0;
   for (const auto& [k, pts] : series) n += pts.size();
-  std::cerr << "mjtether: plotted " << n << " points in " << order.size() << " series to "
-            << p.out << "\n";
+  std::cerr << "mjtether: plotted " << n << " points in " << order.size() << " series to " << p.out
+            << "\n";
   return 0;
 }
 

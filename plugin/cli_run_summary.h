@@ -49,11 +49,7 @@ class RunSummary {
   // The row for the state d ends in: time, peak, and the vehicle's position [m] and
   // orientation (unit quaternion w,x,y,z) from its free joint (empty without a vehicle).
   std::string Row(const mjModel* m, const mjData* d) const {
-    char buf[64];
-    auto num = [&](double v) {
-      std::snprintf(buf, sizeof(buf), "%.17g", v);
-      return std::string(buf);
-    };
+    auto num = [](double v) { return Shortest(v); };
     std::string row = num(d->time) + "," + num(peak_) + "," +
                       (peak_tether_ >= 0 ? CsvField(TetherName(m, peak_tether_)) : "") + "," +
                       num(peak_time_) + ",";

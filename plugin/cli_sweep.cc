@@ -63,10 +63,10 @@ struct Row {
   int number = 0;  // 1-based data row
   int line = 0;    // line in the manifest
   std::string id;
-  std::string model_path;  // resolved against the manifest's directory
-  std::string duration;    // as written (passed on verbatim)
-  std::vector<std::string> cells;                // every manifest column but id, as written
-  std::vector<mjtether::Override> overrides;     // the non-empty override cells
+  std::string model_path;                     // resolved against the manifest's directory
+  std::string duration;                       // as written (passed on verbatim)
+  std::vector<std::string> cells;             // every manifest column but id, as written
+  std::vector<mjtether::Override> overrides;  // the non-empty override cells
 };
 
 struct Manifest {
@@ -146,8 +146,8 @@ bool ReadManifest(const std::string& path, Manifest* mf, std::string* error) {
     } else {
       mjtether::Override o;
       if (!mjtether::SplitOverrideName(name, &o, &message)) {
-        *error = path + ": line 1: column " + message +
-                 "; the other columns are model, duration and id";
+        *error =
+            path + ": line 1: column " + message + "; the other columns are model, duration and id";
         return false;
       }
       override_cols.push_back(static_cast<int>(c));
@@ -225,8 +225,7 @@ bool ReadManifest(const std::string& path, Manifest* mf, std::string* error) {
 }
 
 // Loads each row's model with its overrides: the same parser and range checks as the MJCF.
-bool CheckModels(const std::string& path, const std::vector<const Row*>& rows,
-                 std::string* error) {
+bool CheckModels(const std::string& path, const std::vector<const Row*>& rows, std::string* error) {
   for (const Row* row : rows) {
     std::string message;
     if (!fs::is_regular_file(row->model_path)) {
@@ -236,8 +235,8 @@ bool CheckModels(const std::string& path, const std::vector<const Row*>& rows,
       mj_deleteModel(m);
       continue;
     }
-    *error = path + ": line " + std::to_string(row->line) + " (row " +
-             std::to_string(row->number) + ", id " + row->id + "): " + message;
+    *error = path + ": line " + std::to_string(row->line) + " (row " + std::to_string(row->number) +
+             ", id " + row->id + "): " + message;
     return false;
   }
   return true;
@@ -257,11 +256,7 @@ std::vector<std::string> SummaryHeader(const Manifest& mf) {
   return h;
 }
 
-std::string Num(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.17g", v);
-  return buf;
-}
+std::string Num(double v) { return mjtether::cli::Shortest(v); }
 
 // The first fields of a row's summary line: what defines the run (resume compares them).
 std::vector<std::string> RowSpec(const Row& row, const SweepOptions& opt) {
@@ -388,7 +383,8 @@ std::string RecordRow(const SweepOptions& opt, const Manifest& mf, const Row& ro
     message = std::string("killed by signal ") + std::to_string(WTERMSIG(wstatus)) + " (" +
               strsignal(WTERMSIG(wstatus)) + ")";
   }
-  if (code != 0 && message.empty()) message = LastMessage((out / (row.id + ".stderr.txt")).string());
+  if (code != 0 && message.empty())
+    message = LastMessage((out / (row.id + ".stderr.txt")).string());
   std::vector<std::string> fields = RowSpec(row, opt);
   fields.push_back(status);
   fields.push_back(code >= 0 ? std::to_string(code) : "");
@@ -448,9 +444,10 @@ class Progress {
     const double elapsed = Elapsed();
     if (!tty_ || status != "ok") {
       if (tty_) std::cerr << "\r\033[K";
+      char seconds[32];
+      std::snprintf(seconds, sizeof(seconds), "%.2f", wall);
       std::cerr << "mjtether: sweep: row " << row.number << " (id " << row.id << ") " << status
-                << " in " << Num(std::round(wall * 100) / 100) << " s [" << done_ << "/"
-                << total_ << "]\n";
+                << " in " << seconds << " s [" << done_ << "/" << total_ << "]\n";
     }
     if (tty_) Draw(elapsed);
   }
@@ -494,7 +491,12 @@ int RunRows(const SweepOptions& opt, const Manifest& mf, const std::vector<const
   progress.Start();
   std::map<pid_t, Child> running;
   size_t next = 0;
+  bool stopping = false;
   while (next < todo.size() || !running.empty()) {
+    if (g_signal && !stopping) {
+      for (auto& [child, c] : running) kill(child, SIGTERM);  // stop the rows too
+      stopping = true;
+    }
     while (!g_signal && next < todo.size() && static_cast<int>(running.size()) < jobs) {
       const Row& row = *todo[next++];
       std::remove(ResultPath(opt, row).c_str());  // not done until it finishes again
@@ -509,20 +511,20 @@ int RunRows(const SweepOptions& opt, const Manifest& mf, const std::vector<const
     int wstatus = 0;
     const pid_t pid = waitpid(-1, &wstatus, 0);
     if (pid < 0) {
-      if (errno == EINTR) {
-        for (auto& [child, c] : running) kill(child, SIGTERM);  // stop the rows too
-        continue;
-      }
+      if (errno == EINTR) continue;
       break;  // no children left
     }
     auto it = running.find(pid);
     if (it == running.end()) continue;
     const Row& row = *it->second.row;
     const double wall =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - it->second.start)
-            .count();
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - it->second.start).count();
     running.erase(it);
-    if (g_signal) continue;  // stopped by the user: not done, a resume runs it again
+    // A row stopped by the interrupt is not done: a resume runs it again.
+    const bool stopped =
+        WIFSIGNALED(wstatus) ||
+        (WIFEXITED(wstatus) && (WEXITSTATUS(wstatus) == 130 || WEXITSTATUS(wstatus) == 143));
+    if (g_signal && stopped) continue;
     progress.Done(row, RecordRow(opt, mf, row, wstatus, wall), wall);
   }
   progress.Finish();
@@ -542,8 +544,9 @@ bool SelectRows(const SweepOptions& opt, const Manifest& mf, std::vector<const R
     if (n == 1) b = a;
     if (!((n == 1) || (n == 3 && dash == '-')) || a < 1 || b < a ||
         b > static_cast<int>(mf.rows.size())) {
-      *error = "--rows " + opt.rows + ": expected A-B (or A) with 1 <= A <= B <= " +
-               std::to_string(mf.rows.size()) + " (the manifest's rows)";
+      *error = "--rows " + opt.rows +
+               ": expected A-B (or A) with 1 <= A <= B <= " + std::to_string(mf.rows.size()) +
+               " (the manifest's rows)";
       return false;
     }
     first = a;
@@ -693,7 +696,7 @@ int Sweep(const SweepOptions& opt) {
   }
   std::cerr << "mjtether: sweep: " << (interrupted ? "interrupted; " : "") << rows.size()
             << " rows, " << rows.size() - not_ok << " ok, " << not_ok << " not ok; "
-            << Num(std::round(wall * 10) / 10) << " s wall"
+            << std::round(wall * 10) / 10 << " s wall"
             << (opt.rows.empty() ? "; summary: " + (fs::path(opt.out) / "summary.csv").string()
                                  : std::string("; merge with --merge"))
             << "\n";
@@ -728,7 +731,6 @@ std::function<int()> SetupSweep(CLI::App* sub) {
 }
 
 const bool registered = mjtether::cli::Register(
-    {"sweep", "run a CSV manifest of overridden models on every core, or on Slurm",
-     SetupSweep});
+    {"sweep", "run a CSV manifest of overridden models on every core, or on Slurm", SetupSweep});
 
 }  // namespace

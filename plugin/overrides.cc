@@ -58,11 +58,16 @@ std::string Unescape(const std::string& v) {
       continue;
     }
     const std::string ref = v.substr(i + 1, semi - i - 1);
-    if (ref == "lt") out += '<';
-    else if (ref == "gt") out += '>';
-    else if (ref == "amp") out += '&';
-    else if (ref == "quot") out += '"';
-    else if (ref == "apos") out += '\'';
+    if (ref == "lt")
+      out += '<';
+    else if (ref == "gt")
+      out += '>';
+    else if (ref == "amp")
+      out += '&';
+    else if (ref == "quot")
+      out += '"';
+    else if (ref == "apos")
+      out += '\'';
     else if (ref.size() > 1 && ref[0] == '#') {
       const bool hex = ref[1] == 'x' || ref[1] == 'X';
       AppendUtf8(std::strtoul(ref.c_str() + (hex ? 2 : 1), nullptr, hex ? 16 : 10), &out);
@@ -78,11 +83,20 @@ std::string Escape(const std::string& v) {
   std::string out;
   for (char c : v) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -214,7 +228,8 @@ std::optional<Override> ParseOverride(const std::string& spec, std::string* erro
   }
   for (char c : o.value) {
     if (IsSpace(c) || c == '\0') {
-      *error = "'" + spec + "': the value contains white space (list items are separated by "
+      *error = "'" + spec +
+               "': the value contains white space (list items are separated by "
                "commas, without spaces: 0.5,0,0)";
       return std::nullopt;
     }

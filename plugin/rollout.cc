@@ -26,11 +26,16 @@ struct Part {
 };
 
 std::vector<Part> Parts(const mjModel* m) {
-  return {{&mjData::qpos, m->nq},           {&mjData::qvel, m->nv},
-          {&mjData::act, m->na},            {&mjData::qacc_warmstart, m->nv},
-          {&mjData::ctrl, m->nu},           {&mjData::qfrc_applied, m->nv},
-          {&mjData::xfrc_applied, 6 * m->nbody}, {&mjData::mocap_pos, 3 * m->nmocap},
-          {&mjData::mocap_quat, 4 * m->nmocap},  {&mjData::userdata, m->nuserdata}};
+  return {{&mjData::qpos, m->nq},
+          {&mjData::qvel, m->nv},
+          {&mjData::act, m->na},
+          {&mjData::qacc_warmstart, m->nv},
+          {&mjData::ctrl, m->nu},
+          {&mjData::qfrc_applied, m->nv},
+          {&mjData::xfrc_applied, 6 * m->nbody},
+          {&mjData::mocap_pos, 3 * m->nmocap},
+          {&mjData::mocap_quat, 4 * m->nmocap},
+          {&mjData::userdata, m->nuserdata}};
 }
 
 }  // namespace
@@ -82,8 +87,8 @@ void RolloutPool::One(mjData* d, int i) {
   SetState(m, d, initial_ + (shared_initial_ ? 0 : size_t(i) * r.nstate));
   int s = 0;
   for (; s < r.steps; ++s) {
-    if (controls_) std::memcpy(d->ctrl, controls_ + (size_t(i) * r.steps + s) * m->nu,
-                               sizeof(double) * m->nu);
+    if (controls_)
+      std::memcpy(d->ctrl, controls_ + (size_t(i) * r.steps + s) * m->nu, sizeof(double) * m->nu);
     if (*policy_) (*policy_)(m, d, i, s);
     if (options_.prescribe) Prescribe(m, d);
     mj_step(m, d);
@@ -100,8 +105,7 @@ void RolloutPool::One(mjData* d, int i) {
     r.time[row] = d->time;
     std::memcpy(&r.qpos[row * r.nq], d->qpos, sizeof(double) * r.nq);
     std::memcpy(&r.qvel[row * r.nv], d->qvel, sizeof(double) * r.nv);
-    std::memcpy(&r.sensordata[row * r.nsensordata], d->sensordata,
-                sizeof(double) * r.nsensordata);
+    std::memcpy(&r.sensordata[row * r.nsensordata], d->sensordata, sizeof(double) * r.nsensordata);
     for (int k = 0; k < r.ntether; ++k) {
       const EndReactions e = GetReactions(m, d, k);
       r.tension[(row * r.ntether + k) * 2] = e.tension_a;

@@ -111,8 +111,7 @@ class RolloutPool {
 
 // One-off: a pool for this call only.
 Rollouts Rollout(const mjModel* m, const double* initial, int n, const double* controls,
-                 const Policy& policy, int steps, int threads = 0,
-                 bool shared_initial = false);
+                 const Policy& policy, int steps, int threads = 0, bool shared_initial = false);
 
 }  // namespace mjtether
 

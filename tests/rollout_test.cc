@@ -1,6 +1,11 @@
 // Rollouts on a thread pool (plugin/rollout.h): each rollout bit-identical to the same run done
 // alone with mj_step, whatever the number of threads; a policy; chaining through the final
 // state; a rollout that diverges stops alone. Also built under ThreadSanitizer by tools/tsan.sh.
+#include "rollout.h"
+
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
+
 #include <atomic>
 #include <cmath>
 #include <cstring>
@@ -9,12 +14,8 @@
 #include <string>
 #include <vector>
 
-#include <gtest/gtest.h>
-#include <mujoco/mujoco.h>
-
-#include "mujoco_fixture.h"
 #include "mjtether.h"
-#include "rollout.h"
+#include "mujoco_fixture.h"
 
 namespace mjtether {
 namespace {
@@ -84,8 +85,8 @@ TEST_F(RolloutTest, BitIdenticalToRunningEachAlone) {
   const std::vector<double> u = Controls(m, n);
   std::vector<std::vector<double>> alone(n), final_alone(n);
   for (int i = 0; i < n; ++i) {
-    alone[i] = Alone(m, &x0[size_t(i) * ns], &u[size_t(i) * kSteps * m->nu], nullptr, i,
-                     &final_alone[i]);
+    alone[i] =
+        Alone(m, &x0[size_t(i) * ns], &u[size_t(i) * kSteps * m->nu], nullptr, i, &final_alone[i]);
   }
   for (int threads : {1, 2, 3}) {
     const Rollouts r = Rollout(m, x0.data(), n, u.data(), nullptr, kSteps, threads);
@@ -94,9 +95,9 @@ TEST_F(RolloutTest, BitIdenticalToRunningEachAlone) {
       EXPECT_EQ(r.message[i], "");
       EXPECT_EQ(std::memcmp(r.Qpos(i, 0), alone[i].data(), sizeof(double) * kSteps * m->nq), 0)
           << "rollout " << i << ", " << threads << " threads";
-      EXPECT_EQ(std::memcmp(&r.final_state[size_t(i) * ns], final_alone[i].data(),
-                            sizeof(double) * ns),
-                0)
+      EXPECT_EQ(
+          std::memcmp(&r.final_state[size_t(i) * ns], final_alone[i].data(), sizeof(double) * ns),
+          0)
           << "rollout " << i << ", " << threads << " threads";
       EXPECT_GT(r.Tension(i, kSteps - 1, 0, 1), 0);
     }
@@ -140,10 +141,10 @@ TEST_F(RolloutTest, ChainingThroughTheFinalStateIsExact) {
   const Rollouts second = pool.Run(first.final_state.data(), n, nullptr, nullptr, 200);
   for (int i = 0; i < n; ++i) {
     EXPECT_EQ(std::memcmp(second.Qpos(i, 199), whole.Qpos(i, 399), sizeof(double) * m->nq), 0);
-    EXPECT_EQ(std::memcmp(&second.final_state[size_t(i) * whole.nstate],
-                          &whole.final_state[size_t(i) * whole.nstate],
-                          sizeof(double) * whole.nstate),
-              0);
+    EXPECT_EQ(
+        std::memcmp(&second.final_state[size_t(i) * whole.nstate],
+                    &whole.final_state[size_t(i) * whole.nstate], sizeof(double) * whole.nstate),
+        0);
   }
 }
 

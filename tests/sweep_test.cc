@@ -1,6 +1,7 @@
 // Declaration overrides (plugin/overrides.h), `mjtether run --set/--summary`, `mjtether sweep`
 // (local, resume, failures, bad input, the Slurm scripts run by hand) and `mjtether plot --x
 // --y`. The CLI is run as a child process on the default scene.
+#include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -14,8 +15,6 @@
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "cli_csv.h"
 #include "mjtether.h"
@@ -42,8 +41,7 @@ bool Contains(const std::string& s, const std::string& part) {
 
 // A fresh folder for one test.
 std::string TempFolder(const std::string& name) {
-  const std::string dir =
-      ::testing::TempDir() + "/sweep_" + name + "_" + std::to_string(getpid());
+  const std::string dir = ::testing::TempDir() + "/sweep_" + name + "_" + std::to_string(getpid());
   std::system(("rm -rf '" + dir + "' && mkdir -p '" + dir + "'").c_str());
   return dir;
 }
@@ -51,8 +49,7 @@ std::string TempFolder(const std::string& name) {
 // Runs a shell command; returns its exit status and its stdout + stderr.
 int RunShell(const std::string& command, std::string* output) {
   const std::string out = ::testing::TempDir() + "/sweep_cli_" + std::to_string(getpid());
-  const int status =
-      std::system(("(" + command + ") > '" + out + "' 2>&1 < /dev/null").c_str());
+  const int status = std::system(("(" + command + ") > '" + out + "' 2>&1 < /dev/null").c_str());
   *output = Read(out);
   std::remove(out.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -123,8 +120,8 @@ TEST(Overrides, RewriteOnlyTheNamedText) {
     <text name="note" data="a=&quot;b&quot;"/></custom>
 </mujoco>)";
   std::string error;
-  std::optional<std::string> out = ApplyOverrides(
-      xml, {{"water", "current", "0.6,0,0"}, {"water", "seabed", "-40"}}, &error);
+  std::optional<std::string> out =
+      ApplyOverrides(xml, {{"water", "current", "0.6,0,0"}, {"water", "seabed", "-40"}}, &error);
   ASSERT_TRUE(out) << error;
   EXPECT_TRUE(Contains(*out, R"(<!-- <text name="water" data="density=1"/> -->)")) << *out;
   EXPECT_TRUE(Contains(*out, R"(data='density=1025 current=0.6,0,0 seabed=-40')")) << *out;
@@ -150,8 +147,7 @@ TEST(Overrides, SameRangeCheckAsTheFile) {
 // `run --set` with a misspelt key: exit 2, the key named.
 TEST(RunSet, UnknownKeyIsBadInput) {
   std::string output;
-  EXPECT_EQ(RunCli("run " + kScene + " --duration 0.1 --set tether:umbilical.EAX=1", &output),
-            2);
+  EXPECT_EQ(RunCli("run " + kScene + " --duration 0.1 --set tether:umbilical.EAX=1", &output), 2);
   EXPECT_TRUE(Contains(output, "'EAX'")) << output;
   EXPECT_EQ(RunCli("run " + kScene + " --duration 0.1 --set water.current", &output), 2);
   EXPECT_TRUE(Contains(output, "TEXT.KEY=VALUE")) << output;
@@ -165,8 +161,8 @@ const double kDuration = 2;  // [s] simulated per row: past the thrust ramp, che
 // The manifest of most tests: the model relative to the manifest (in a sub-folder), a quoted
 // list, an empty cell (no override), and an id column.
 std::string MakeManifest(const std::string& dir) {
-  std::system(("mkdir -p '" + dir + "/models' && cp '" + kScene + "' '" + dir + "/models/'")
-                  .c_str());
+  std::system(
+      ("mkdir -p '" + dir + "/models' && cp '" + kScene + "' '" + dir + "/models/'").c_str());
   std::ostringstream m;
   m << "id,model,duration,water.current,tether:umbilical.EA,tether:umbilical.EAc\n"
     << "stiff,models/rov_tether.xml," << kDuration << ",\"0.6,0,0\",4e5,4e5\n"
@@ -184,12 +180,10 @@ TEST(Sweep, RowMatchesRunOfTheHandEditedModel) {
   const std::string dir = TempFolder("identity");
   const std::string manifest = MakeManifest(dir);
   std::string output;
-  ASSERT_EQ(RunCli("sweep " + manifest + " --out " + dir + "/out --jobs 2", &output), 0)
-      << output;
-  Write(dir + "/hand.xml", HandEdited({{"current=0.3,0,0", "current=0.6,0,0"},
-                                       {"EA=2e5 EAc=2e5", "EA=4e5 EAc=4e5"}}));
-  ASSERT_EQ(RunCli("run " + dir + "/hand.xml --duration 2 --log " + dir + "/hand.csv", &output),
-            0)
+  ASSERT_EQ(RunCli("sweep " + manifest + " --out " + dir + "/out --jobs 2", &output), 0) << output;
+  Write(dir + "/hand.xml",
+        HandEdited({{"current=0.3,0,0", "current=0.6,0,0"}, {"EA=2e5 EAc=2e5", "EA=4e5 EAc=4e5"}}));
+  ASSERT_EQ(RunCli("run " + dir + "/hand.xml --duration 2 --log " + dir + "/hand.csv", &output), 0)
       << output;
   const std::string stiff = Read(dir + "/out/stiff.log.csv");
   EXPECT_GT(stiff.size(), 1000u);
@@ -265,8 +259,7 @@ TEST(Sweep, FailingRowIsRecordedAndTheOthersRun) {
         "models/rov_tether.xml,1,explicit,1\n"
         "models/rov_tether.xml,1,,\n");
   std::string output;
-  EXPECT_EQ(RunCli("sweep " + dir + "/manifest.csv --out " + dir + "/out", &output), 1)
-      << output;
+  EXPECT_EQ(RunCli("sweep " + dir + "/manifest.csv --out " + dir + "/out", &output), 1) << output;
   const auto rows = Summary(dir + "/out/summary.csv");
   ASSERT_EQ(rows.size(), 3u);
   EXPECT_EQ(rows[0].at("status"), "ok");
@@ -293,8 +286,7 @@ TEST(Sweep, BadInputExitsTwoNamingRowAndKey) {
        {"line 3 (row 2", "'EA'", "out of range"}},
       {"model,duration,tether:umbilical.EA\nmodels/rov_tether.xml,1,2e99\n",
        {"line 2 (row 1", "'EA'"}},
-      {"model,duration,tether:nope.EA\nmodels/rov_tether.xml,1,1e5\n",
-       {"row 1", "tether:nope"}},
+      {"model,duration,tether:nope.EA\nmodels/rov_tether.xml,1,1e5\n", {"row 1", "tether:nope"}},
       {"model,duration,water.current\nmodels/rov_tether.xml,1,0.5 0 0\n",
        {"row 1", "water.current", "white space"}},
       {"model,duration,EA\nmodels/rov_tether.xml,1,1e5\n", {"line 1", "'EA'", "TEXT.KEY"}},
@@ -314,6 +306,51 @@ TEST(Sweep, BadInputExitsTwoNamingRowAndKey) {
   }
 }
 
+// The progress bar goes to a terminal only (drawn in place); to a file, one plain line per row.
+// The default number of rows at once is the cores this process may use (taskset: 1).
+TEST(Sweep, ProgressBarOnlyOnATerminal) {
+  const std::string dir = TempFolder("progress");
+  const std::string manifest = MakeManifest(dir);
+  std::string output;
+  ASSERT_EQ(RunShell("taskset -c 0 " + std::string(MJTETHER_CLI) + " sweep " + manifest +
+                         " --out " + dir + "/file",
+                     &output),
+            0)
+      << output;
+  EXPECT_TRUE(Contains(output, "to run on 1 core(s)")) << output;
+  EXPECT_TRUE(Contains(output, "row 2 (id plain) ok in ")) << output;
+  EXPECT_FALSE(Contains(output, "\r")) << output;
+  // script(1) gives the sweep a terminal.
+  ASSERT_EQ(RunShell("script -qec '" + std::string(MJTETHER_CLI) + " sweep " + manifest +
+                         " --out " + dir + "/tty' /dev/null",
+                     &output),
+            0)
+      << output;
+  EXPECT_TRUE(Contains(output, "\r\033[K[##############################] 3/3 rows")) << output;
+  EXPECT_FALSE(Contains(output, "ok in ")) << output;
+}
+
+// SIGTERM stops the sweep and its running rows: exit 143, the rows stopped are not recorded
+// as done (summary: pending), so that a resume runs them again.
+TEST(Sweep, InterruptedRowsAreNotDone) {
+  const std::string dir = TempFolder("interrupt");
+  MakeManifest(dir);
+  Write(dir + "/manifest.csv",
+        "model,duration\nmodels/rov_tether.xml,600\nmodels/rov_tether.xml,600\n");
+  std::string output;
+  const int status =
+      RunShell(std::string(MJTETHER_CLI) + " sweep " + dir + "/manifest.csv --out " + dir +
+                   "/out --jobs 2 --every 10 & sleep 1; kill -TERM $!; wait $!",
+               &output);
+  EXPECT_EQ(status, 143) << output;
+  EXPECT_TRUE(Contains(output, "interrupted; 2 rows, 0 ok, 2 not ok")) << output;
+  EXPECT_FALSE(std::ifstream(dir + "/out/1.result.csv"));
+  const auto rows = Summary(dir + "/out/summary.csv");
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0].at("status"), "pending");
+  EXPECT_EQ(rows[1].at("status"), "pending");
+}
+
 // The Slurm scripts, run by hand as the array's tasks would be (SLURM_ARRAY_TASK_ID 0..2),
 // then the merge: blocks of rows as written in the script, and a summary and logs identical
 // to the local sweep's but for the wall times.
@@ -328,8 +365,7 @@ TEST(Sweep, SlurmScriptTasksGiveTheLocalSweep) {
   Write(manifest, m);  // 7 rows
   std::string output;
   ASSERT_EQ(RunCli("sweep " + manifest + " --out " + dir + "/local", &output), 0) << output;
-  ASSERT_EQ(RunCli("sweep " + manifest + " --out " + dir + "/array --slurm --tasks 3", &output),
-            0)
+  ASSERT_EQ(RunCli("sweep " + manifest + " --out " + dir + "/array --slurm --tasks 3", &output), 0)
       << output;
   const std::string script = Read(dir + "/array/sweep.sbatch");
   EXPECT_TRUE(Contains(script, "#SBATCH --array=0-2\n")) << script;
@@ -342,8 +378,7 @@ TEST(Sweep, SlurmScriptTasksGiveTheLocalSweep) {
         << output;
   }
   EXPECT_FALSE(std::ifstream(dir + "/array/summary.csv")) << "tasks write no summary";
-  ASSERT_EQ(RunShell("cd '" + dir + "/array' && bash merge.sbatch", &output), 0)
-      << output;
+  ASSERT_EQ(RunShell("cd '" + dir + "/array' && bash merge.sbatch", &output), 0) << output;
   auto local = Summary(dir + "/local/summary.csv");
   auto array = Summary(dir + "/array/summary.csv");
   ASSERT_EQ(local.size(), 7u);
@@ -370,18 +405,20 @@ TEST(Plot, SummaryColumns) {
         "d,\"0.2,0,0\",2e5,diverged,\n"
         "e,\"0.3,0,0\",2e5,ok,15\n");
   std::string output;
-  ASSERT_EQ(RunCli("plot " + dir + "/summary.csv --x 'water.current[0]' --y peak_tension --by "
-                   "tether:umbilical.EA --out " + dir + "/p.png",
+  ASSERT_EQ(RunCli("plot " + dir +
+                       "/summary.csv --x 'water.current[0]' --y peak_tension --by "
+                       "tether:umbilical.EA --out " +
+                       dir + "/p.png",
                    &output),
             0)
       << output;
   EXPECT_TRUE(Contains(output, "left out 1 rows whose status is not ok")) << output;
   EXPECT_TRUE(Contains(output, "plotted 4 points in 2 series")) << output;
   EXPECT_EQ(Read(dir + "/p.png").substr(1, 3), "PNG");
-  EXPECT_EQ(RunCli("plot " + dir + "/summary.csv --x current --y peak_tension --out " + dir +
-                       "/q.png",
-                   &output),
-            2);
+  EXPECT_EQ(
+      RunCli("plot " + dir + "/summary.csv --x current --y peak_tension --out " + dir + "/q.png",
+             &output),
+      2);
   EXPECT_TRUE(Contains(output, "no column 'current' (columns: id, water.current")) << output;
 }
 

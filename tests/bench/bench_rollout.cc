@@ -6,13 +6,13 @@
 //
 //   ./build/tests/bench/bench_rollout --benchmark_repetitions=5
 //     --benchmark_report_aggregates_only=true
+#include <benchmark/benchmark.h>
+#include <mujoco/mujoco.h>
+
 #include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <benchmark/benchmark.h>
-#include <mujoco/mujoco.h>
 
 #include "mjtether.h"
 #include "rollout.h"
