@@ -6,7 +6,7 @@
 #   tools/tsan.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMJTETHER_BENCHMARKS=OFF \
+cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMJTETHER_BENCHMARKS=OFF \
   -DCMAKE_CXX_FLAGS="-fsanitize=thread" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=thread" >/dev/null
 cmake --build build-tsan -j"$(nproc)" --target rollout_test robust_test
 export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1"
