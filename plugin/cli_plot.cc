@@ -3,6 +3,7 @@
 //
 //   mjtether plot INPUT --out FILE.png [--duration S] [--every S] [--tether NAME] [--body NAME]
 //       [--size 1000x700]
+//   mjtether plot TABLE.csv --x COL --y COL [--by COL] --out FILE.png   (cli_plot_columns.h)
 //
 // INPUT ending in .csv is read as a run log (columns time, NAME.tension_A, NAME.tension_B,
 // BODY.z); otherwise it is a model, run for --duration seconds and sampled every --every
@@ -20,6 +21,7 @@
 
 #include "cli_command.h"
 #include "cli_pipe.h"
+#include "cli_plot_columns.h"
 #include "cli_step.h"
 #include "mjtether.h"
 #include "render.h"
@@ -34,6 +36,7 @@ struct PlotOptions {
   std::string tether;
   std::string body;
   std::string size = "1000x700";
+  std::string x, y, by;  // a column against another (cli_plot_columns.h)
 };
 
 // The series to plot: time [s], tension at ends A and B [N], vehicle height z [m].
@@ -194,6 +197,9 @@ int Plot(const PlotOptions& opt) {
               << ": expected WIDTHxHEIGHT, each in [200, 8000]\n";
     return 2;
   }
+  if (!opt.x.empty() || !opt.y.empty()) {
+    return mjtether::cli::PlotColumns({opt.input, opt.x, opt.y, opt.by, opt.out, W, H});
+  }
   Series s;
   if (EndsWith(opt.input, ".csv")) {
     std::string error;
@@ -266,6 +272,9 @@ std::function<int()> SetupPlot(CLI::App* sub) {
   sub->add_option("--tether", opt->tether, "tether to plot (default: the first)");
   sub->add_option("--body", opt->body, "body whose depth is plotted (default: the vehicle)");
   sub->add_option("--size", opt->size, "WIDTHxHEIGHT in pixels (default 1000x700)");
+  sub->add_option("--x", opt->x, "CSV table: column for the x axis (NAME or NAME[i])");
+  sub->add_option("--y", opt->y, "CSV table: column for the y axis");
+  sub->add_option("--by", opt->by, "CSV table: one line per value of this column");
   return [opt]() { return Plot(*opt); };
 }
 

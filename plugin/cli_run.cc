@@ -12,8 +12,10 @@
 #include <vector>
 
 #include "cli_command.h"
+#include "cli_run_summary.h"
 #include "declaration.h"
 #include "mjtether.h"
+#include "overrides.h"
 
 namespace {
 
@@ -23,6 +25,8 @@ struct RunOptions {
   std::string log;
   std::string nodes;
   double every = 0.1;
+  std::vector<std::string> set;  // TEXT.KEY=VALUE overrides (overrides.h)
+  std::string summary;           // one-row CSV about the whole run (cli_run_summary.h)
 };
 
 // Bodies with a free joint: the vehicles whose position the log records.
@@ -41,7 +45,16 @@ std::string BodyName(const mjModel* m, int b) {
 
 int Run(const RunOptions& opt) {
   std::string error;
-  mjModel* m = mjtether::LoadModel(opt.model, &error);
+  std::vector<mjtether::Override> overrides;
+  for (const std::string& spec : opt.set) {
+    std::optional<mjtether::Override> o = mjtether::ParseOverride(spec, &error);
+    if (!o) {
+      std::cerr << "mjtether: --set " << error << "\n";
+      return 2;
+    }
+    overrides.push_back(*o);
+  }
+  mjModel* m = mjtether::LoadModel(opt.model, overrides, &error);
   if (!m) {
     std::cerr << "mjtether: " << error << "\n";
     return 2;
@@ -125,6 +138,8 @@ int Run(const RunOptions& opt) {
   const long long steps = std::llround(opt.duration / h);
   const double every = std::max(opt.every, h);
   long long next_sample = 0, sample_index = 0;
+  std::optional<mjtether::cli::RunSummary> run_summary;
+  if (!opt.summary.empty()) run_summary.emplace(m);
   const auto start = std::chrono::steady_clock::now();
   int status = 0;
   for (long long i = 0;; ++i) {
@@ -136,6 +151,7 @@ int Run(const RunOptions& opt) {
     }
     if (i == steps) break;
     mj_step(m, d);
+    if (run_summary) run_summary->Observe(m, d);
     if (std::optional<std::string> diverged = mjtether::CheckDivergence(m, d)) {
       std::cerr << "mjtether: " << *diverged << "\n";
       status = 1;
@@ -156,6 +172,10 @@ int Run(const RunOptions& opt) {
               << (wall > 0 ? d->time / wall : 0) << "x real time)";
     if (!opt.log.empty()) std::cerr << "; log: " << opt.log;
     std::cerr << "\n";
+  }
+  if (run_summary && !run_summary->Write(opt.summary, m, d)) {
+    std::cerr << "mjtether: cannot write --summary " << opt.summary << "\n";
+    status = status ? status : 2;
   }
   mj_deleteData(d);
   mjtether::Detach(m);
@@ -221,6 +241,13 @@ std::function<int()> SetupRun(CLI::App* sub) {
   sub->add_option("--nodes", opt->nodes, "CSV: time,tether,node,x,y,z,tension");
   sub->add_option("--every", opt->every, "sampling interval of both CSV files [s]")
       ->check(CLI::Range(1e-9, 1e7));
+  sub->add_option("--set", opt->set,
+                  "override one declaration key, TEXT.KEY=VALUE (e.g. water.current=0.5,0,0); "
+                  "repeatable")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  sub->add_option("--summary", opt->summary,
+                  "CSV row: peak tension over every step, the vehicle's final pose");
   return [opt]() { return Run(*opt); };
 }
 
