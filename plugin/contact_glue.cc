@@ -260,7 +260,7 @@ bool ResolveContactGeoms(const mjModel* m, const std::string& spec, const int si
 
 int FindContacts(const mjModel* m, const mjData* d, const TetherContacts& tc,
                  const Tether& tether, const double* xp, const double* vp, double dt,
-                 ContactPoint* out, int capacity, int* dropped) {
+                 double* boxes, ContactPoint* out, int capacity, int* dropped) {
   const int N = tether.segments();
   ConstNodes x(xp, 3, N + 1), v(vp, 3, N + 1);
   const double r = 0.5 * tether.params().diameter;
@@ -271,6 +271,20 @@ int FindContacts(const mjModel* m, const mjData* d, const TetherContacts& tc,
   const double reach = r + 2 * dt * vmax + 1e-3 * L0;
   int count = 0;
   *dropped = 0;
+  // Boxes of 8 segments (lo, hi: 6 doubles each) and of the whole tether, once per call.
+  const int chunks = (N + kChunk - 1) / kChunk;
+  Vec3 all_lo = x.col(0), all_hi = x.col(0);
+  for (int c = 0; c < chunks; ++c) {
+    const int c0 = c * kChunk, c1 = std::min(N, c0 + kChunk);
+    const Vec3 lo = x.middleCols(c0, c1 - c0 + 1).rowwise().minCoeff();
+    const Vec3 hi = x.middleCols(c0, c1 - c0 + 1).rowwise().maxCoeff();
+    for (int k = 0; k < 3; ++k) boxes[6 * c + k] = lo[k], boxes[6 * c + 3 + k] = hi[k];
+    all_lo = all_lo.cwiseMin(lo);
+    all_hi = all_hi.cwiseMax(hi);
+  }
+  auto apart = [](const Vec3& p, const Vec3& lo, const Vec3& hi, double bound) {
+    return ((p.array() < lo.array() - bound) || (p.array() > hi.array() + bound)).any();
+  };
   for (const ContactGeom& cg : tc.geoms) {
     const int g = cg.geom;
     const int type = m->geom_type[g];
@@ -280,16 +294,23 @@ int FindContacts(const mjModel* m, const mjData* d, const TetherContacts& tc,
     const bool plane = type == mjGEOM_PLANE;
     // Velocity of the geom's body: twist at the geom's centre (a mocap body moved by a
     // motion: declaration has its prescribed velocity; another mocap body none).
-    mjtNum twist[6];
-    mj_objectVelocity(m, d, mjOBJ_GEOM, g, twist, 0);
-    const Vec3 w(twist[0], twist[1], twist[2]);
-    Vec3 vg(twist[3], twist[4], twist[5]);
+    // Geoms welded to the world (scenery) have none, without asking.
     const int body = m->geom_bodyid[g];
-    if (m->body_mocapid[body] >= 0) PrescribedVelocity(m, d, body, &vg);
+    Vec3 w = Vec3::Zero(), vg = Vec3::Zero();
+    if (m->body_mocapid[body] >= 0) {
+      PrescribedVelocity(m, d, body, &vg);
+    } else if (m->body_weldid[body] != 0) {
+      mjtNum twist[6];
+      mj_objectVelocity(m, d, mjOBJ_GEOM, g, twist, 0);
+      w = Vec3(twist[0], twist[1], twist[2]);
+      vg = Vec3(twist[3], twist[4], twist[5]);
+    }
     const double margin = reach + 2 * dt * (vg.norm() + w.norm() * m->geom_rbound[g]);
     const double bound = m->geom_rbound[g] + margin;
+    if (!plane && apart(pos, all_lo, all_hi, bound)) continue;
     for (int c0 = 0; c0 < N; c0 += kChunk) {
       const int c1 = std::min(N, c0 + kChunk);
+      const double* box = boxes + 6 * (c0 / kChunk);
       // Broad phase: the chunk's box against the geom's bounding sphere (a plane: its
       // signed distance against the chunk's lowest node).
       if (plane) {
@@ -297,21 +318,14 @@ int FindContacts(const mjModel* m, const mjData* d, const TetherContacts& tc,
         double lowest = INFINITY;
         for (int i = c0; i <= c1; ++i) lowest = std::min(lowest, nrm.dot(x.col(i) - pos));
         if (lowest > margin) continue;
-      } else {
-        const Vec3 lo = x.middleCols(c0, c1 - c0 + 1).rowwise().minCoeff();
-        const Vec3 hi = x.middleCols(c0, c1 - c0 + 1).rowwise().maxCoeff();
-        if (((pos.array() < lo.array() - bound) || (pos.array() > hi.array() + bound)).any()) {
-          continue;
-        }
+      } else if (apart(pos, Vec3(box), Vec3(box + 3), bound)) {
+        continue;
       }
       for (int j = c0; j < c1; ++j) {
         if (j * L0 < cg.skip[0] || (N - j - 1) * L0 < cg.skip[1]) continue;
         const Vec3 a = x.col(j), b = x.col(j + 1);
         if (!plane) {
-          const Vec3 lo = a.cwiseMin(b), hi = a.cwiseMax(b);
-          if (((pos.array() < lo.array() - bound) || (pos.array() > hi.array() + bound)).any()) {
-            continue;
-          }
+          if (apart(pos, a.cwiseMin(b), a.cwiseMax(b), bound)) continue;
         }
         // Narrow phase in the geom's frame.
         const Closest c = SegmentGeom(type, sz, R.transpose() * (a - pos),

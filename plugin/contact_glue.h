@@ -35,10 +35,12 @@ bool ResolveContactGeoms(const mjModel* m, const std::string& spec, const int si
 // The candidates of one step [t, t + dt]: every segment point of the state x (3 x n) within a
 // margin of a geom as it is in d (broad phase on bounding spheres against 8-segment boxes,
 // then the segment-geom closest points). Writes at most `capacity` into out; returns the
-// count, and sets *dropped to the number left out. Allocates nothing.
+// count, and sets *dropped to the number left out. `boxes` is scratch of ChunkBoxesSize
+// doubles. Allocates nothing.
 int FindContacts(const mjModel* m, const mjData* d, const TetherContacts& tc,
                  const Tether& tether, const double* x, const double* v, double dt,
-                 ContactPoint* out, int capacity, int* dropped);
+                 double* boxes, ContactPoint* out, int capacity, int* dropped);
+inline int ChunkBoxesSize(int segments) { return 6 * (segments / 8 + 1); }
 
 }  // namespace mjtether
 

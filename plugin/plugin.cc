@@ -60,7 +60,8 @@ struct AttachedTether {
 // Doubles of mjData stack for one step's contact candidates.
 int ContactWorkSize(const AttachedTether& at) {
   if (!at.contact) return 0;
-  return static_cast<int>((at.contacts.capacity * sizeof(ContactPoint) + sizeof(double) - 1) /
+  return ChunkBoxesSize(at.tether.segments()) +
+         static_cast<int>((at.contacts.capacity * sizeof(ContactPoint) + sizeof(double) - 1) /
                           sizeof(double));
 }
 
@@ -195,8 +196,9 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
     ContactSet set;
     if (at.contact) {
       int dropped = 0;
-      set.points = reinterpret_cast<ContactPoint*>(work + tether.WorkspaceSize());
-      set.count = FindContacts(m, d, at.contacts, tether, x, v, dt, set.points,
+      double* boxes = work + tether.WorkspaceSize();
+      set.points = reinterpret_cast<ContactPoint*>(boxes + ChunkBoxesSize(tether.segments()));
+      set.count = FindContacts(m, d, at.contacts, tether, x, v, dt, boxes, set.points,
                                at.contacts.capacity, &dropped);
       set.time_ref = d->time;
       u[kContactDropped] = dropped;

@@ -116,6 +116,8 @@ TEST_P(Capstan, TensionRatioIsExpMuTheta) {
   }
   const double ratio = sum_a / sum_b;
   const double expected = std::exp(cc.mu * th);
+  std::printf("capstan mu=%g theta=%g: T_A/T_B = %.4f, exp(mu theta) = %.4f\n", cc.mu, th, ratio,
+              expected);
   if (cc.mu == 0) {
     EXPECT_NEAR(ratio, 1.0, 0.005) << "frictionless: equal tensions";
   } else {
