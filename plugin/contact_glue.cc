@@ -34,9 +34,12 @@ bool Supported(int type) {
 
 const char* TypeName(int type) {
   switch (type) {
-    case mjGEOM_HFIELD: return "hfield";
-    case mjGEOM_MESH: return "mesh";
-    default: return "this type";
+    case mjGEOM_HFIELD:
+      return "hfield";
+    case mjGEOM_MESH:
+      return "mesh";
+    default:
+      return "this type";
   }
 }
 
@@ -258,9 +261,9 @@ bool ResolveContactGeoms(const mjModel* m, const std::string& spec, const int si
   return true;
 }
 
-int FindContacts(const mjModel* m, const mjData* d, const TetherContacts& tc,
-                 const Tether& tether, const double* xp, const double* vp, double dt,
-                 double* boxes, ContactPoint* out, int capacity, int* dropped) {
+int FindContacts(const mjModel* m, const mjData* d, const TetherContacts& tc, const Tether& tether,
+                 const double* xp, const double* vp, double dt, double* boxes, ContactPoint* out,
+                 int capacity, int* dropped) {
   const int N = tether.segments();
   ConstNodes x(xp, 3, N + 1), v(vp, 3, N + 1);
   const double r = 0.5 * tether.params().diameter;
@@ -328,8 +331,8 @@ int FindContacts(const mjModel* m, const mjData* d, const TetherContacts& tc,
           if (apart(pos, a.cwiseMin(b), a.cwiseMax(b), bound)) continue;
         }
         // Narrow phase in the geom's frame.
-        const Closest c = SegmentGeom(type, sz, R.transpose() * (a - pos),
-                                      R.transpose() * (b - pos));
+        const Closest c =
+            SegmentGeom(type, sz, R.transpose() * (a - pos), R.transpose() * (b - pos));
         if (!(c.dist < margin)) continue;
         if (count == capacity) {
           ++*dropped;

@@ -37,9 +37,9 @@ bool ResolveContactGeoms(const mjModel* m, const std::string& spec, const int si
 // then the segment-geom closest points). Writes at most `capacity` into out; returns the
 // count, and sets *dropped to the number left out. `boxes` is scratch of ChunkBoxesSize
 // doubles. Allocates nothing.
-int FindContacts(const mjModel* m, const mjData* d, const TetherContacts& tc,
-                 const Tether& tether, const double* x, const double* v, double dt,
-                 double* boxes, ContactPoint* out, int capacity, int* dropped);
+int FindContacts(const mjModel* m, const mjData* d, const TetherContacts& tc, const Tether& tether,
+                 const double* x, const double* v, double dt, double* boxes, ContactPoint* out,
+                 int capacity, int* dropped);
 inline int ChunkBoxesSize(int segments) { return 6 * (segments / 8 + 1); }
 
 }  // namespace mjtether

@@ -17,14 +17,14 @@ namespace mjtether {
 //   g = normal . (x_s - p(t)) - d/2,   x_s = (1 - s) x_j + s x_{j+1},
 // and it is in contact while g < 0.
 struct ContactPoint {
-  int segment = 0;                // j, 0 <= j < N
-  double s = 0;                   // [-] 0 at node j, 1 at node j+1
-  Vec3 point = Vec3::Zero();      // [m] surface point at time_ref, world frame
-  Vec3 normal = Vec3::UnitZ();    // [-] unit, pointing out of the other body
-  Vec3 velocity = Vec3::Zero();   // [m/s] velocity of the body's material point at `point`
-  Vec3 impulse = Vec3::Zero();    // [N s] out: impulse on the tether, summed by Advance
-  Vec3 stage = Vec3::Zero();      // [N s] scratch (first stage of implicit2)
-  int tag = -1;                   // the caller's (the MuJoCo glue: the geom's body)
+  int segment = 0;               // j, 0 <= j < N
+  double s = 0;                  // [-] 0 at node j, 1 at node j+1
+  Vec3 point = Vec3::Zero();     // [m] surface point at time_ref, world frame
+  Vec3 normal = Vec3::UnitZ();   // [-] unit, pointing out of the other body
+  Vec3 velocity = Vec3::Zero();  // [m/s] velocity of the body's material point at `point`
+  Vec3 impulse = Vec3::Zero();   // [N s] out: impulse on the tether, summed by Advance
+  Vec3 stage = Vec3::Zero();     // [N s] scratch (first stage of implicit2)
+  int tag = -1;                  // the caller's (the MuJoCo glue: the geom's body)
 };
 
 // The candidates of one Advance (owned by the caller; Advance only writes `impulse`/`stage`).

@@ -28,8 +28,7 @@ std::string Scene(int segments, const char* contact, int boxes) {
   std::string grid;
   for (int k = 0; k < boxes; ++k) {
     char buf[160];
-    std::snprintf(buf, sizeof(buf),
-                  "<geom type=\"box\" size=\"0.2 0.2 0.2\" pos=\"%g %g -3\"/>\n",
+    std::snprintf(buf, sizeof(buf), "<geom type=\"box\" size=\"0.2 0.2 0.2\" pos=\"%g %g -3\"/>\n",
                   -9.5 + (k % 20), -4.5 + (k / 20));
     grid += buf;
   }
@@ -40,12 +39,14 @@ std::string Scene(int segments, const char* contact, int boxes) {
     <site name="b" pos="10 0 0"/>
     <geom name="pipe" type="cylinder" size="0.3 2" pos="0 0 -1.4" zaxis="0 1 0"/>
     <geom name="far" type="box" size="0.5 0.5 0.5" pos="40 0 0"/>
-    )" + grid + R"(
+    )" + grid +
+         R"(
   </worldbody>
   <custom>
     <text name="tether:t" data="ends=a,b length=20.2 segments=)" +
          std::to_string(segments) + R"( diameter=0.03 mass_per_length=1 EA=1e5
-      EAc=1e5 EI=1 damping=100 integrator=implicit )" + contact + R"("/>
+      EAc=1e5 EI=1 damping=100 integrator=implicit )" +
+         contact + R"("/>
   </custom>
 </mujoco>)";
 }
