@@ -77,6 +77,11 @@ EndReactions GetReactions(const mjModel* m, const mjData* d, int k);
 // one of a tether with EAc, reads 0.
 void GetTensions(const mjModel* m, const mjData* d, int k, double* T);
 
+// Contact (docs/contact.md): the impulse [N s] the geoms gave tether k over its last advance
+// (the bodies received its opposite), and the candidates left out for lack of room then.
+Vec3 ContactImpulse(const mjModel* m, const mjData* d, int k);
+int ContactDropped(const mjModel* m, const mjData* d, int k);
+
 // If a tether in d has diverged, a message naming the tether, the time and the node, and
 // what to change; the diverged tether stops applying forces. Otherwise nullopt.
 std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d);

@@ -12,6 +12,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "contact_glue.h"
 #include "declaration.h"
 #include "mjtether.h"
 #include "vehicle_glue.h"
@@ -34,8 +35,16 @@ enum Slot : int {
   kPrevTime,         // [s] the tether's time one call before kTime (== kTime: none yet)
   kPrevPosA,         // position(3) of end A at kPrevTime (mocap velocity, second order)
   kPrevPosB = kPrevPosA + 3,
-  kHeader = kPrevPosB + 3,           // x (3 x n) then v (3 x n) follow
+  kContactImpulse = kPrevPosB + 3,  // [N s] (3) contact impulse on the tether, last advance
+  kContactCount = kContactImpulse + 3,  // reactions stored below (contact effect)
+  kContactDropped,   // candidates beyond capacity at the last advance
+  kContactEndA,      // [N] (3) contact force on end node A (passed to its site), last advance
+  kContactEndB = kContactEndA + 3,  // [N] (3) the same for end B
+  kHeader = kContactEndB + 3,  // x (3 x n) then v (3 x n) follow, then with contact `capacity` records
 };
+// A contact reaction record: body, force on it [N] (3), point of application [m] (3), applied
+// at every callback until the next advance replaces them.
+constexpr int kContactRecord = 7;
 
 struct AttachedTether {
   std::string name;
@@ -44,7 +53,17 @@ struct AttachedTether {
   int body[2] = {-1, -1};
   bool mocap[2] = {false, false};  // end on a mocap body: velocity by finite difference
   int offset = 0;                  // start of this tether's block in userdata
+  bool contact = false;            // the contact effect is on
+  TetherContacts contacts;         // the geoms it may touch (contact_glue.h)
 };
+
+// Doubles of mjData stack for one step's contact candidates.
+int ContactWorkSize(const AttachedTether& at) {
+  if (!at.contact) return 0;
+  return ChunkBoxesSize(at.tether.segments()) +
+         static_cast<int>((at.contacts.capacity * sizeof(ContactPoint) + sizeof(double) - 1) /
+                          sizeof(double));
+}
 
 struct ModelTethers {
   std::string source;
@@ -171,7 +190,23 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
     StoreEnd(now.b, u + kEndB);
   } else if (d->time > u[kTime]) {
     Ends from{LoadEnd(u + kEndA), LoadEnd(u + kEndB)};
-    StepStatus status = tether.Advance(x, v, from, now, d->time - u[kTime], work);
+    const double dt = d->time - u[kTime];
+    // Contact: candidates from the state at the tether's time and the geoms as they are now;
+    // the planes move with their bodies in between (contact.h).
+    ContactSet set;
+    if (at.contact) {
+      int dropped = 0;
+      double* boxes = work + tether.WorkspaceSize();
+      set.points = reinterpret_cast<ContactPoint*>(boxes + ChunkBoxesSize(tether.segments()));
+      set.count = FindContacts(m, d, at.contacts, tether, x, v, dt, boxes, set.points,
+                               at.contacts.capacity, &dropped);
+      set.time_ref = d->time;
+      u[kContactDropped] = dropped;
+      from.time = u[kTime];
+      now.time = d->time;
+      from.contacts = now.contacts = &set;
+    }
+    StepStatus status = tether.Advance(x, v, from, now, dt, work);
     if (!status.ok) {
       u[kStatus] = status.reason.rfind("strain", 0) == 0    ? 2
                    : status.reason.rfind("kinetic", 0) == 0 ? 3
@@ -179,6 +214,33 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
       u[kBadNode] = status.node;
       u[kBadTime] = d->time;
       return;
+    }
+    // Each body gets the opposite of the impulse its geoms gave the tether, spread over the
+    // next step as a constant force at the contact point.
+    if (at.contact) {
+      double* rec = x + tether.StateSize();
+      Vec3 total = Vec3::Zero(), end_a = Vec3::Zero(), end_b = Vec3::Zero();
+      int stored = 0;
+      for (int k = 0; k < set.count; ++k) {
+        const ContactPoint& c = set.points[k];
+        if (c.impulse.isZero(0)) continue;
+        total += c.impulse;
+        // The attached end nodes' share reaches the sites' bodies.
+        if (c.segment == 0) end_a += (1 - c.s) * c.impulse / dt;
+        if (c.segment == tether.segments() - 1 && !free_end) end_b += c.s * c.impulse / dt;
+        double* r = rec + kContactRecord * stored++;
+        r[0] = c.tag;
+        for (int i = 0; i < 3; ++i) {
+          r[1 + i] = -c.impulse[i] / dt;
+          r[4 + i] = c.point[i];
+        }
+      }
+      for (int i = 0; i < 3; ++i) {
+        u[kContactImpulse + i] = total[i];
+        u[kContactEndA + i] = end_a[i];
+        u[kContactEndB + i] = end_b[i];
+      }
+      u[kContactCount] = stored;
     }
     u[kPrevTime] = u[kTime];
     std::copy(u + kEndA, u + kEndA + 3, u + kPrevPosA);
@@ -188,8 +250,29 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
     StoreEnd(now.b, u + kEndB);
   }
 
-  // Reactions from the state and the sites as they are at this call.
+  // Contact reactions of the last advance, at every call until the next one.
+  if (at.contact) {
+    const double* rec = x + tether.StateSize();
+    const mjtNum zero[3] = {0, 0, 0};
+    for (int k = 0; k < static_cast<int>(u[kContactCount]); ++k) {
+      const double* r = rec + kContactRecord * k;
+      const int body = static_cast<int>(r[0]);
+      if (body <= 0 || m->body_mocapid[body] >= 0) continue;
+      mj_applyFT(m, d, r + 1, zero, r + 4, body, d->qfrc_passive);
+    }
+  }
+  // Reactions from the state and the sites as they are at this call (no contact candidates:
+  // the end nodes' contact share is in the state's last advance, and in the records above).
+  now.contacts = nullptr;
   EndReactions r = tether.Reactions(x, v, now, work);
+  if (at.contact) {
+    r.force_a += Vec3(u + kContactEndA);
+    r.tension_a = r.force_a.norm();
+    if (!free_end) {
+      r.force_b += Vec3(u + kContactEndB);
+      r.tension_b = r.force_b.norm();
+    }
+  }
   double* cache = u + kForceA;
   for (int i = 0; i < 3; ++i) {
     cache[i] = r.force_a[i];
@@ -330,6 +413,7 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
                               "bending; declare EAc (e.g. EAc = EA) for zero-tension loops");
     }
     AttachedTether at{name.substr(7), *tether};
+    at.contact = (tether->params().effects & kContact) != 0;
     const std::string sites[2] = {decl->site_a, decl->site_b};
     for (int end = 0; end < 2; ++end) {
       if (sites[end].empty()) continue;  // free end B
@@ -340,13 +424,25 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
       at.body[end] = m->site_bodyid[at.site[end]];
       at.mocap[end] = m->body_mocapid[m->body_rootid[at.body[end]]] >= 0;
     }
-    const long long block = kHeader + static_cast<long long>(tether->StateSize());
+    if (at.contact) {
+      std::vector<std::string> notes;
+      if (!ResolveContactGeoms(m, decl->contact, at.site, *tether, &at.contacts, &notes,
+                               &message)) {
+        return fail(name, message);
+      }
+      for (const std::string& n : notes) {
+        set->warnings.push_back(source + ": <text name=\"" + name + "\">: " + n);
+      }
+    }
+    const long long block = kHeader + static_cast<long long>(tether->StateSize()) +
+                            (at.contact ? kContactRecord * at.contacts.capacity : 0);
     if (offset + block > 1'000'000'000LL) {
       return fail(name, "the tethers need more than 1e9 doubles of state: fewer segments");
     }
     at.offset = offset;
     offset += static_cast<int>(block);
-    set->work_size = std::max(set->work_size, tether->WorkspaceSize());
+    set->work_size =
+        std::max(set->work_size, tether->WorkspaceSize() + ContactWorkSize(at));
     set->tethers.push_back(std::move(at));
   }
   // Vehicles, motions and thrust schedules (plugin/vehicles.cc) use the same callback.
@@ -490,6 +586,20 @@ void GetTensions(const mjModel* m, const mjData* d, int k, double* T) {
     return;
   }
   tether->Tensions(x, x + 3 * tether->nodes(), T);
+}
+
+Vec3 ContactImpulse(const mjModel* m, const mjData* d, int k) {
+  const double* u = UserBlock(m, d, k);
+  if (!u || !GetTether(m, k) || !(GetTether(m, k)->params().effects & kContact)) {
+    return Vec3::Zero();
+  }
+  return Vec3(u + kContactImpulse);
+}
+
+int ContactDropped(const mjModel* m, const mjData* d, int k) {
+  const double* u = UserBlock(m, d, k);
+  if (!u || !GetTether(m, k) || !(GetTether(m, k)->params().effects & kContact)) return 0;
+  return static_cast<int>(u[kContactDropped]);
 }
 
 std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d) {

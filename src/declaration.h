@@ -37,6 +37,9 @@ struct TetherDeclaration {
   std::string site_a;
   std::string site_b;  // empty when end B is free
   std::string effects_text;  // `effects=` as written; empty: defaults
+  // `contact=` as written: "all" or a comma list of geom or body names (resolved by the
+  // MuJoCo glue); empty: no contact.
+  std::string contact;
 };
 
 // Parses the water declaration.
@@ -50,11 +53,12 @@ std::optional<TetherDeclaration> ParseTether(const std::string& text, const Envi
 // The effects a tether simulates. Defaults: axial always; damping if damping > 0; bending if
 // EI > 0; weight if gravity != 0; in water buoyancy (gravity != 0), drag if Cdn or Cdt > 0,
 // added mass if Can > 0, current if the current is non-zero, seabed if declared; clamp if a
-// clamp is declared; compression if EAc > 0. `effects=` (comma list of kEffectNames)
+// clamp is declared; compression if EAc > 0; contact if `contact=` is given. `effects=` (comma list of kEffectNames)
 // replaces the defaults; naming an effect whose coefficient or declaration is missing is an
 // error.
 std::optional<unsigned> ResolveEffects(const TetherParams& p, const Environment& env,
-                                       const std::string& effects_text, DeclarationError* error);
+                                       const std::string& effects_text, DeclarationError* error,
+                                       bool has_contact = false);
 
 // "axial,weight,..." for a bit set.
 std::string EffectsToString(unsigned effects);

@@ -27,14 +27,15 @@ enum Effect : unsigned {
   kSeabed = 1u << 8,     // flat seabed: penalty, damping, Coulomb friction
   kClamp = 1u << 9,      // clamped end(s): tangent held, bending moment to the body
   kCompression = 1u << 10,  // shortened segments push back, EAc*strain (declared by EAc)
+  kContact = 1u << 11,   // segments against MuJoCo geoms: penalty, damping, Coulomb friction
 };
 
 // Name of each effect as written in `effects=` (same order as the bits).
 inline constexpr const char* kEffectNames[] = {"axial",    "damping",    "bending", "weight",
                                                "buoyancy", "drag",       "added_mass",
                                                "current",  "seabed",     "clamp",
-                                               "compression"};
-inline constexpr int kNumEffects = 11;
+                                               "compression", "contact"};
+inline constexpr int kNumEffects = 12;
 
 // How nodal curvature is measured from the turning angle theta between two segments (both
 // give the same small-angle stiffness EI/w; they differ at large angles per node).
@@ -98,6 +99,12 @@ struct TetherParams {
   double max_step = 0;         // [s] largest tether step; 0: automatic
   double max_strain = 1.0;     // [-] strain above which the run is declared diverged
   unsigned effects = 0;        // bit set of Effect, resolved by the parser
+  // Contact with MuJoCo geoms (declared by `contact=`; docs/contact.md). Per unit length of
+  // tether: a segment's contact point carries the stiffness of its rest length L0.
+  double contact_stiffness = 1e6;  // [N/m^2] normal force per length of tether per penetration
+  double contact_damping = -1;     // [N s/m^2] per length; < 0: critical for the tether's mass
+  double contact_friction = 0;     // [-] Coulomb coefficient (isotropic)
+  double contact_friction_speed = 0.01;  // [m/s] slip speed over which friction saturates (tanh)
 };
 
 // Everything a Tether needs from its surroundings.

@@ -116,7 +116,8 @@ EndState Interpolate(const EndState& e0, const EndState& e1, double dt, double s
 }
 
 Ends Interpolate(const Ends& from, const Ends& to, double dt, double s) {
-  return {Interpolate(from.a, to.a, dt, s), Interpolate(from.b, to.b, dt, s)};
+  return {Interpolate(from.a, to.a, dt, s), Interpolate(from.b, to.b, dt, s),
+          from.time + s * (to.time - from.time), to.contacts};
 }
 
 }  // namespace
@@ -177,6 +178,13 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
                       ? env.water.seabed_damping
                       : 2 * std::sqrt(c.seabed_k_ * params.mass_per_length);
   }
+  // Contact per unit length, the same way (a segment's contact point carries its length L0).
+  if (c.Has(kContact)) {
+    c.contact_k_ = params.contact_stiffness;
+    c.contact_c_ = params.contact_damping >= 0
+                       ? params.contact_damping
+                       : 2 * std::sqrt(c.contact_k_ * params.mass_per_length);
+  }
 
   // Explicit stability limit. Highest frequencies of the discrete operators on the lightest
   // dynamic node: axial chain 4 (EA/L0)/m (EA the larger of EA and EAc when compressed
@@ -198,6 +206,8 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
       w2 += (c.Has(kClamp) ? 32 : 16) * params.EI / (c.L0_ * c.L0_ * c.L0_ * mn_min);
     }
     if (c.Has(kSeabed)) w2 += c.seabed_k_ * c.L0_ / m_min;
+    // A contact point at a node puts its whole stiffness k L0 on that node.
+    if (c.Has(kContact)) w2 += c.contact_k_ * c.L0_ / m_min;
     double rate = 0;  // [1/s] damping / mass
     if (c.Has(kDamping)) rate += 4 * (params.damping / c.L0_) / m_min;
     if (c.Has(kSeabed)) {
@@ -206,6 +216,7 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
       const double wet = c.weight_.col(1 % n).norm() / std::max(c.share_(1 % n), 1e-300);
       rate += mu * wet * c.L0_ / (env.water.seabed_friction_speed * m_min);
     }
+    if (c.Has(kContact)) rate += c.contact_c_ * c.L0_ / m_min;
     const double w = std::sqrt(w2);
     const double zeta = rate / (2 * w);
     c.explicit_dt_ = kExplicitSafety * (params.integrator == Integrator::kRK4
@@ -500,6 +511,67 @@ void Tether::AddSeabed(ConstNodes x, ConstNodes v, ConstNodes q, Nodes f) const 
   }
 }
 
+// Contact with another body's surface (contact.h): on the point x_s of segment j at fraction s,
+// a penalty per unit length (the segment's rest length L0) on the penetration of the tether's
+// surface, with damping on the normal approach speed, never pulling:
+//   N = max(0, L0 (k (-g) - c vn)),  g = n.(x_s - p(t)) - d/2,  vn = n.(v_s - v_b),
+// and Coulomb friction on the slip velocity vt = (v_s - v_b) - vn n, smoothed like the
+// seabed's: -mu N tanh(|vt|/eps) vt/|vt|. The force acts at x_s, shared (1 - s), s by the
+// segment's two nodes (the linear shape functions). dt_ref = t - time_ref.
+Vec3 Tether::ContactForce(const ContactPoint& c, const double* xp, const double* vp, double dt_ref,
+                          double* normal_force) const {
+  ConstNodes x(xp, 3, N_ + 1), v(vp, 3, N_ + 1);
+  const int j = c.segment;
+  const double s = c.s;
+  const Vec3 xs = (1 - s) * x.col(j) + s * x.col(j + 1);
+  const Vec3 p = c.point + dt_ref * c.velocity;
+  const double gap = c.normal.dot(xs - p) - 0.5 * p_.diameter;
+  *normal_force = 0;
+  if (!(gap < 0)) return Vec3::Zero();
+  const Vec3 vrel = (1 - s) * v.col(j) + s * v.col(j + 1) - c.velocity;
+  const double vn = c.normal.dot(vrel);
+  const double N = std::max(0.0, L0_ * (contact_k_ * -gap - contact_c_ * vn));
+  *normal_force = N;
+  Vec3 F = N * c.normal;
+  if (p_.contact_friction > 0 && N > 0) {
+    const Vec3 vt = vrel - vn * c.normal;
+    const double slip = vt.norm();
+    if (slip > 0) {
+      F -= (p_.contact_friction * N * std::tanh(slip / p_.contact_friction_speed) / slip) * vt;
+    }
+  }
+  return F;
+}
+
+void Tether::AddContact(ConstNodes x, ConstNodes v, const Ends& ends, Nodes f) const {
+  const ContactSet& set = *ends.contacts;
+  const double dt_ref = ends.time - set.time_ref;
+  for (int k = 0; k < set.count; ++k) {
+    const ContactPoint& c = set.points[k];
+    double N;
+    const Vec3 F = ContactForce(c, x.data(), v.data(), dt_ref, &N);
+    if (N == 0) continue;
+    f.col(c.segment) += (1 - c.s) * F;
+    f.col(c.segment + 1) += c.s * F;
+  }
+}
+
+// Adds weight x the contact force of the state (x, v) at `ends` to each candidate's impulse
+// (or to its `stage` scratch): each integrator calls it with the weights by which its update
+// combines the forces of its stages, so that the impulses are the ones the tether received.
+void Tether::AccumulateContactImpulse(const double* x, const double* v, const Ends& ends,
+                                      double weight, bool to_stage) const {
+  if (!Has(kContact) || !ends.contacts) return;
+  const ContactSet& set = *ends.contacts;
+  const double dt_ref = ends.time - set.time_ref;
+  for (int k = 0; k < set.count; ++k) {
+    ContactPoint& c = set.points[k];
+    double N;
+    const Vec3 F = ContactForce(c, x, v, dt_ref, &N);
+    (to_stage ? c.stage : c.impulse) += weight * F;
+  }
+}
+
 void Tether::ComputeForces(const double* xp, const double* vp, const Ends& ends, double* fp,
                            double* Tp, double* work) const {
   Work w(work, N_);
@@ -520,6 +592,7 @@ void Tether::ComputeForces(const double* xp, const double* vp, const Ends& ends,
   if (Has(kDrag) || Has(kAddedMass) || Has(kSeabed)) NodeTangents(x, tc, q);
   if (Has(kDrag)) AddDrag(v, qc, w.l, f);
   if (Has(kSeabed)) AddSeabed(x, v, qc, f);
+  if (Has(kContact) && ends.contacts) AddContact(x, v, ends, f);
 }
 
 EndReactions Tether::Reactions(const double* xp, const double* vp, const Ends& ends,
@@ -535,25 +608,42 @@ EndReactions Tether::Reactions(const double* xp, const double* vp, const Ends& e
     double* scratch = io + kWindowIo;
     ConstNodes x(xp, 3, n), v(vp, 3, n);
     Nodes X(wx, 3, 3), V(wv, 3, 3);
+    // The window knows nothing of the candidates (they index the whole tether): the contact
+    // share of each end node is added below.
+    Ends we = ends;
+    we.contacts = nullptr;
+    auto contact_on_node = [&](int i) {
+      Vec3 F = Vec3::Zero();
+      if (!Has(kContact) || !ends.contacts) return F;
+      const ContactSet& set = *ends.contacts;
+      for (int k = 0; k < set.count; ++k) {
+        const ContactPoint& c = set.points[k];
+        if (c.segment != i && c.segment != i - 1) continue;
+        double N;
+        const Vec3 Fc = ContactForce(c, x.data(), v.data(), ends.time - set.time_ref, &N);
+        F += (c.segment == i ? 1 - c.s : c.s) * Fc;
+      }
+      return F;
+    };
     ConstNodes F(wf, 3, 3), M(Work(scratch, 2).M, 3, 3);
     EndReactions r;
     X.col(0) = ends.a.pos;
     V.col(0) = ends.a.vel;
     X.rightCols(2) = x.middleCols(1, 2);
     V.rightCols(2) = v.middleCols(1, 2);
-    wt.ComputeForces(wx, wv, ends, wf, wT, scratch);
-    r.force_a = F.col(0);
+    wt.ComputeForces(wx, wv, we, wf, wT, scratch);
+    r.force_a = F.col(0) + contact_on_node(0);
     r.tension_a = r.force_a.norm();
     if (Has(kClamp) && p_.clamp_a) r.torque_a = M.col(0);
     X.leftCols(2) = x.middleCols(N_ - 2, 2);
     V.leftCols(2) = v.middleCols(N_ - 2, 2);
     X.col(2) = p_.free_end ? Vec3(x.col(N_)) : ends.b.pos;
     V.col(2) = p_.free_end ? Vec3(v.col(N_)) : ends.b.vel;
-    wt.ComputeForces(wx, wv, ends, wf, wT, scratch);
+    wt.ComputeForces(wx, wv, we, wf, wT, scratch);
     if (p_.free_end) {
       r.tension_b = wT[1];
     } else {
-      r.force_b = F.col(2);
+      r.force_b = F.col(2) + contact_on_node(N_);
       r.tension_b = r.force_b.norm();
       if (Has(kClamp) && p_.clamp_b) r.torque_b = -M.col(2);
     }
@@ -668,6 +758,7 @@ void Tether::ExplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
                           double* work) const {
   Work w(work, N_);
   ComputeForces(x.data(), v.data(), now, w.f, nullptr, work);
+  AccumulateContactImpulse(x.data(), v.data(), now, h, false);  // v+ = v + h M^-1 f(x, v)
   ConstNodes f(w.f, 3, N_ + 1), q(w.q, 3, N_ + 1);
   for (int i = 1; i <= N_; ++i) {
     if (!Dynamic(i)) continue;
@@ -702,6 +793,7 @@ void Tether::Rk4Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double
     const Ends& e = *ends[k];
     PlaceEnds(e, xk, vk);
     ComputeForces(w.x2, w.v2, e, w.f, nullptr, work);
+    AccumulateContactImpulse(xk.data(), vk.data(), e, b[k] * h / 6, false);
     for (int i = 0; i < n; ++i) {
       if (!Dynamic(i)) continue;
       const Vec3 ai = Acceleration(i, f.col(i), q.col(i)), vi = vk.col(i);
@@ -879,6 +971,47 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         d(1, 1) += h * secant;
       }
     }
+    // Contact: normal stiffness and damping L0 (h^2 k + h c) n n^T and the friction's
+    // derivative in the tangent plane at the contact point, shared by the segment's
+    // nodes with the weights (1 - s), s of the force (so w_a w_b on each block).
+    if (Has(kContact) && next.contacts) {
+      const ContactSet& set = *next.contacts;
+      const double dt_ref = next.time - set.time_ref;
+      for (int k = 0; k < set.count; ++k) {
+        const ContactPoint& c = set.points[k];
+        double N;
+        ContactForce(c, xk.data(), vk.data(), dt_ref, &N);
+        const Vec3 xs = (1 - c.s) * xk.col(c.segment) + c.s * xk.col(c.segment + 1);
+        if (!(c.normal.dot(xs - c.point - dt_ref * c.velocity) < 0.5 * p_.diameter)) continue;
+        const Mat3 nn = c.normal * c.normal.transpose();
+        Mat3 B = (L0_ * (h2 * contact_k_ + h * contact_c_)) * nn;
+        if (p_.contact_friction > 0 && N > 0) {
+          const Vec3 vrel = (1 - c.s) * vk.col(c.segment) + c.s * vk.col(c.segment + 1) -
+                            c.velocity;
+          const Vec3 vt = vrel - c.normal.dot(vrel) * c.normal;
+          const double slip = vt.norm();
+          const double eps = p_.contact_friction_speed;
+          const double muN = p_.contact_friction * N;
+          // Tangent of mu N tanh(|vt|/eps) vt/|vt|: sech^2/eps along the slip, the secant
+          // tanh(|vt|/eps)/|vt| across it (both mu N/eps at rest). The secant along the slip
+          // too would hold a sliding tether back at the creep speed step after step.
+          if (slip > 1e-9 * eps) {
+            const Vec3 e = vt / slip;
+            const double th = std::tanh(slip / eps);
+            const Mat3 ee = e * e.transpose();
+            B += h * muN * ((1 - th * th) / eps * ee + th / slip * (I - nn - ee));
+          } else {
+            B += h * muN / eps * (I - nn);
+          }
+        }
+        const int j = c.segment;
+        const double wa = 1 - c.s, wb = c.s;
+        const bool d0 = Dynamic(j), d1 = Dynamic(j + 1);
+        if (d0) A.D(j - 1) += (wa * wa) * B;
+        if (d1) A.D(j) += (wb * wb) * B;
+        if (d0 && d1) A.L1(j) += (wa * wb) * B;
+      }
+    }
     // Solve; a failed factorisation leaves NaN behind for the divergence check to report.
     if (A.Factor() >= 0) {
       vk.col(1).setConstant(NAN);
@@ -896,6 +1029,27 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
       changed = ((xk.col(j + 1) - xk.col(j)).squaredNorm() > L0sq) != (w.l[j] > L0_);
     }
     settled = !changed;
+    // Friction saturates over the slip speed eps: where the slip of a contact in the solve
+    // changed the friction's tanh by more than 0.1, the linearisation was not good for it
+    // (a tether starting to slide): iterate again from the new iterate.
+    if (settled && Has(kContact) && next.contacts && p_.contact_friction > 0) {
+      const ContactSet& set = *next.contacts;
+      const double eps = p_.contact_friction_speed;
+      for (int k = 0; k < set.count && settled; ++k) {
+        const ContactPoint& c = set.points[k];
+        // Node velocity after the solve, and before it (the solve added rhs to it).
+        auto node_v = [&](int i, bool after) -> Vec3 {
+          if (after || !Dynamic(i)) return vk.col(i);
+          return vk.col(i) - rhs.col(i - 1);
+        };
+        auto slip = [&](bool after) {
+          const Vec3 vr = (1 - c.s) * node_v(c.segment, after) +
+                          c.s * node_v(c.segment + 1, after) - c.velocity;
+          return (vr - c.normal.dot(vr) * c.normal).norm();
+        };
+        settled = std::abs(std::tanh(slip(true) / eps) - std::tanh(slip(false) / eps)) <= 0.1;
+      }
+    }
     // The linearisation also took each taut segment's new length as l + t . d(dx), along its
     // tangent at the start; a segment that turns by theta in the step is longer than that by
     // about l theta^2/2, which is tension the solve did not see. Where that would exceed
@@ -922,19 +1076,23 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
 // ends at the midpoint from the same Hermite curve), down to 1/2^kMaxHalvings of the step;
 // at that depth the last iterate is accepted.
 void Tether::ImplicitStepAdaptive(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
-                                  int depth, double* work) const {
+                                  int depth, double* work, double impulse_weight) const {
   constexpr int kMaxHalvings = 8;
   Work w(work, N_);
   const int n = N_ + 1;
   Nodes xs(w.xs, 3, n), vs(w.vs, 3, n);
   xs = x;
   vs = v;
-  if (ImplicitStep(x, v, now, next, h, work) || depth == kMaxHalvings) return;
+  if (ImplicitStep(x, v, now, next, h, work) || depth == kMaxHalvings) {
+    // Backward Euler: M (v+ - v) = h f(x+, v+), so the impulse is h times the final force.
+    AccumulateContactImpulse(x.data(), v.data(), next, impulse_weight * h, false);
+    return;
+  }
   x = xs;
   v = vs;
   const Ends mid = Interpolate(now, next, h, 0.5);
-  ImplicitStepAdaptive(x, v, now, mid, h / 2, depth + 1, work);
-  ImplicitStepAdaptive(x, v, mid, next, h / 2, depth + 1, work);
+  ImplicitStepAdaptive(x, v, now, mid, h / 2, depth + 1, work, impulse_weight);
+  ImplicitStepAdaptive(x, v, mid, next, h / 2, depth + 1, work, impulse_weight);
 }
 
 // Two-stage, stiffly accurate, L-stable SDIRK of order 2 (Alexander, SIAM J. Numer. Anal. 14,
@@ -964,6 +1122,12 @@ void Tether::Sdirk2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, dou
     ImplicitStepAdaptive(x, v, now, next, h, 0, work);
   };
   if (!ImplicitStep(x, v, now, mid, kGamma * h, work)) return fall_back();
+  // Contact impulse: y+ = y + (1 - gamma) h F(Y1) + gamma h F(Y2); the first part is kept
+  // aside until the second stage settles (a fallback replaces both).
+  if (Has(kContact) && mid.contacts) {
+    for (int k = 0; k < mid.contacts->count; ++k) mid.contacts->points[k].stage.setZero();
+    AccumulateContactImpulse(x.data(), v.data(), mid, (1 - kGamma) * h, true);
+  }
   // x, v hold Y1; form y~ on the dynamic nodes (the ends are set by the next stage).
   const double a = (1 - kGamma) / kGamma;
   for (int i = 0; i < n; ++i) {
@@ -971,7 +1135,14 @@ void Tether::Sdirk2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, dou
     x.col(i) = x0.col(i) + (1 - kGamma) * h * v.col(i);
     v.col(i) = v0.col(i) + a * (v.col(i) - v0.col(i));
   }
-  if (!ImplicitStep(x, v, mid, next, kGamma * h, work)) fall_back();
+  if (!ImplicitStep(x, v, mid, next, kGamma * h, work)) return fall_back();
+  if (Has(kContact) && next.contacts) {
+    for (int k = 0; k < next.contacts->count; ++k) {
+      ContactPoint& c = next.contacts->points[k];
+      c.impulse += c.stage;
+    }
+    AccumulateContactImpulse(x.data(), v.data(), next, kGamma * h, false);
+  }
 }
 
 StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends& to, double dt,

@@ -23,6 +23,7 @@
 
 #include <Eigen/Core>
 
+#include "contact.h"
 #include "params.h"
 
 namespace mjtether {
@@ -41,6 +42,10 @@ struct EndState {
 struct Ends {
   EndState a;
   EndState b;  // unused when end B is free
+  // With the contact effect: the time of this instant [s] and the contact candidates
+  // (contact.h), shared by every instant of one Advance; null: no contact this step.
+  double time = 0;
+  const ContactSet* contacts = nullptr;
 };
 
 // What the tether does to the sites it is attached to.
@@ -134,6 +139,11 @@ class Tether {
   void NodeTangents(ConstNodes x, ConstNodes t, Nodes q) const;
   void AddDrag(ConstNodes v, ConstNodes q, const double* l, Nodes f) const;
   void AddSeabed(ConstNodes x, ConstNodes v, ConstNodes q, Nodes f) const;
+  Vec3 ContactForce(const ContactPoint& c, const double* xp, const double* vp, double dt_ref,
+                    double* normal_force) const;
+  void AddContact(ConstNodes x, ConstNodes v, const Ends& ends, Nodes f) const;
+  void AccumulateContactImpulse(const double* x, const double* v, const Ends& ends, double weight,
+                                bool to_stage) const;
 
   // Integrators (one step of size h; ends already set at the start, `next` at the end).
   void PlaceEnds(const Ends& e, Nodes x, Nodes v) const;
@@ -145,7 +155,8 @@ class Tether {
   bool ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
                     double* work) const;
   void ImplicitStepAdaptive(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
-                            int depth, double* work) const;
+                            int depth, double* work, double impulse_weight = 1) const;
+
   void Sdirk2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
                   double* work) const;
 
@@ -159,6 +170,7 @@ class Tether {
   double area_ = 0;             // [m^2] pi d^2 / 4
   double kn_ = 0, kt_ = 0;      // [kg/m^2] 1/2 rho Cdn d, 1/2 rho Cdt pi d (per length)
   double seabed_k_ = 0, seabed_c_ = 0;  // [N/m^2], [N s/m^2] per length
+  double contact_k_ = 0, contact_c_ = 0;  // [N/m^2], [N s/m^2] per length
   double explicit_dt_ = 0;      // [s]
   Eigen::VectorXd mass_;        // [kg] (n) dry lumped mass
   Eigen::VectorXd added_;       // [kg] (n) normal added mass Can rho A l_i

@@ -1,0 +1,356 @@
+// Tether-geom contact: which geoms a tether may touch, and the candidates of each step.
+//
+// Geometry is our own: the closest point between a segment (the tether's axis) and a geom,
+// in the geom's frame, from closed forms for plane, sphere and capsule, and for box, cylinder
+// and ellipsoid from a golden-section search along the segment of the geom's signed distance
+// (convex along a line for a convex body, so the search finds the minimum). Why not
+// mjCOLLISIONFUNC: it needs geoms of the model for the segments, and returns nothing beyond
+// its margin or for a segment deep inside; why not libccd/libfcl: a conversion per segment per
+// step for shapes that have closed forms. See docs/contact.md.
+#include "contact_glue.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <new>
+#include <sstream>
+
+#include "vehicle_glue.h"
+
+namespace mjtether {
+namespace {
+
+using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+
+// Segments per broad-phase box.
+constexpr int kChunk = 8;
+// Golden-section iterations along a segment: 0.618^40 ~ 4e-9 of its length.
+constexpr int kGoldenIterations = 40;
+
+bool Supported(int type) {
+  return type == mjGEOM_PLANE || type == mjGEOM_SPHERE || type == mjGEOM_CAPSULE ||
+         type == mjGEOM_CYLINDER || type == mjGEOM_BOX || type == mjGEOM_ELLIPSOID;
+}
+
+const char* TypeName(int type) {
+  switch (type) {
+    case mjGEOM_HFIELD:
+      return "hfield";
+    case mjGEOM_MESH:
+      return "mesh";
+    default:
+      return "this type";
+  }
+}
+
+// Signed distance of the local point p to a box, cylinder or ellipsoid of MuJoCo size `sz`
+// (box: half sizes; cylinder: radius, half length along z; ellipsoid: semi-axes).
+double SignedDistance(int type, const double* sz, const Vec3& p) {
+  if (type == mjGEOM_BOX) {
+    const Vec3 q = p.cwiseAbs() - Vec3(sz[0], sz[1], sz[2]);
+    return q.cwiseMax(0.0).norm() + std::min(q.maxCoeff(), 0.0);
+  }
+  if (type == mjGEOM_CYLINDER) {
+    const double dr = std::hypot(p.x(), p.y()) - sz[0], dz = std::abs(p.z()) - sz[1];
+    return std::hypot(std::max(dr, 0.0), std::max(dz, 0.0)) + std::min(std::max(dr, dz), 0.0);
+  }
+  // Ellipsoid: the first-order estimate k0 (k0 - 1)/k1 (exact on a sphere and on the axes).
+  const Vec3 r(sz[0], sz[1], sz[2]);
+  const double k0 = p.cwiseQuotient(r).norm();
+  const double k1 = p.cwiseQuotient(r.cwiseProduct(r)).norm();
+  if (k1 == 0) return -r.minCoeff();
+  return k0 * (k0 - 1) / k1;
+}
+
+// Outward unit normal of a box, cylinder or ellipsoid at local p: the gradient of the signed
+// distance by central differences (step small against the geom).
+Vec3 Normal(int type, const double* sz, const Vec3& p) {
+  const double e = 1e-7 * std::max({sz[0], sz[1], type == mjGEOM_CYLINDER ? sz[0] : sz[2]});
+  Vec3 g;
+  for (int k = 0; k < 3; ++k) {
+    Vec3 a = p, b = p;
+    a[k] += e;
+    b[k] -= e;
+    g[k] = SignedDistance(type, sz, a) - SignedDistance(type, sz, b);
+  }
+  const double n = g.norm();
+  return n > 0 ? Vec3(g / n) : Vec3::UnitZ();
+}
+
+// Closest points of segments [a0, a1] and [b0, b1]: parameters s (on a), t (on b)
+// (Ericson, Real-Time Collision Detection, 2005, section 5.1.9).
+void SegmentSegment(const Vec3& a0, const Vec3& a1, const Vec3& b0, const Vec3& b1, double* s,
+                    double* t) {
+  const Vec3 d1 = a1 - a0, d2 = b1 - b0, r = a0 - b0;
+  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
+  const double tiny = 1e-24;
+  if (a <= tiny && e <= tiny) {
+    *s = *t = 0;
+    return;
+  }
+  if (a <= tiny) {
+    *s = 0;
+    *t = std::clamp(f / e, 0.0, 1.0);
+    return;
+  }
+  const double c = d1.dot(r);
+  if (e <= tiny) {
+    *t = 0;
+    *s = std::clamp(-c / a, 0.0, 1.0);
+    return;
+  }
+  const double b = d1.dot(d2), denom = a * e - b * b;
+  // Parallel segments: any s; take the middle of the overlap's start.
+  *s = denom > 1e-12 * a * e ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.5;
+  *t = (b * *s + f) / e;
+  if (*t < 0) {
+    *t = 0;
+    *s = std::clamp(-c / a, 0.0, 1.0);
+  } else if (*t > 1) {
+    *t = 1;
+    *s = std::clamp((b - c) / a, 0.0, 1.0);
+  }
+}
+
+// Closest point of the local segment [a, b] to the geom: its parameter s, the signed distance
+// of the segment point to the geom's surface, the outward normal and the surface point.
+struct Closest {
+  double s, dist;
+  Vec3 normal, surface;
+};
+
+Closest SegmentGeom(int type, const double* sz, const Vec3& a, const Vec3& b) {
+  Closest c;
+  auto from_center = [&](const Vec3& q, const Vec3& center, double radius) {
+    const Vec3 r = q - center;
+    const double len = r.norm();
+    c.normal = len > 0 ? Vec3(r / len) : Vec3::UnitZ();
+    c.dist = len - radius;
+    c.surface = center + radius * c.normal;
+  };
+  if (type == mjGEOM_PLANE) {
+    // Infinite plane z = 0 (MuJoCo's planes collide beyond their drawn size).
+    const double dz = b.z() - a.z();
+    c.s = std::abs(dz) <= 1e-9 * (a - b).norm() ? 0.5 : (dz > 0 ? 0.0 : 1.0);
+    const Vec3 q = a + c.s * (b - a);
+    c.dist = q.z();
+    c.normal = Vec3::UnitZ();
+    c.surface = Vec3(q.x(), q.y(), 0);
+    return c;
+  }
+  if (type == mjGEOM_SPHERE) {
+    const Vec3 d = b - a;
+    const double dd = d.squaredNorm();
+    c.s = dd > 0 ? std::clamp(-a.dot(d) / dd, 0.0, 1.0) : 0.0;
+    from_center(a + c.s * d, Vec3::Zero(), sz[0]);
+    return c;
+  }
+  if (type == mjGEOM_CAPSULE) {
+    double t;
+    const Vec3 b0(0, 0, -sz[1]), b1(0, 0, sz[1]);
+    SegmentSegment(a, b, b0, b1, &c.s, &t);
+    from_center(a + c.s * (b - a), b0 + t * (b1 - b0), sz[0]);
+    return c;
+  }
+  // Box, cylinder, ellipsoid: golden section on the signed distance along the segment.
+  constexpr double kInvPhi = 0.61803398874989484820;
+  auto f = [&](double s) { return SignedDistance(type, sz, a + s * (b - a)); };
+  double lo = 0, hi = 1;
+  double x1 = hi - kInvPhi * (hi - lo), x2 = lo + kInvPhi * (hi - lo);
+  double f1 = f(x1), f2 = f(x2);
+  for (int it = 0; it < kGoldenIterations; ++it) {
+    if (f1 <= f2) {
+      hi = x2;
+      x2 = x1;
+      f2 = f1;
+      x1 = hi - kInvPhi * (hi - lo);
+      f1 = f(x1);
+    } else {
+      lo = x1;
+      x1 = x2;
+      f1 = f2;
+      x2 = lo + kInvPhi * (hi - lo);
+      f2 = f(x2);
+    }
+  }
+  // The ends are candidates too (the search brackets an interior minimum).
+  c.s = 0.5 * (lo + hi);
+  double best = f(c.s);
+  for (double end : {0.0, 1.0}) {
+    const double fe = f(end);
+    if (fe < best) best = fe, c.s = end;
+  }
+  const Vec3 q = a + c.s * (b - a);
+  c.dist = best;
+  c.normal = Normal(type, sz, q);
+  c.surface = q - best * c.normal;
+  return c;
+}
+
+}  // namespace
+
+bool ResolveContactGeoms(const mjModel* m, const std::string& spec, const int site[2],
+                         const Tether& tether, TetherContacts* out,
+                         std::vector<std::string>* warnings, std::string* error) {
+  std::vector<int> geoms;
+  if (spec == "all") {
+    // Every geom that would collide with a geom of contype 1 and conaffinity 1.
+    for (int g = 0; g < m->ngeom; ++g) {
+      if (!((m->geom_contype[g] & 1) || (m->geom_conaffinity[g] & 1))) continue;
+      if (!Supported(m->geom_type[g])) {
+        const char* name = m->names + m->name_geomadr[g];
+        std::ostringstream s;
+        s << "key 'contact' = all: geom " << (name[0] ? name : std::to_string(g).c_str())
+          << " is a " << TypeName(m->geom_type[g])
+          << ", which tether contact does not support yet; it is left out";
+        warnings->push_back(s.str());
+        continue;
+      }
+      geoms.push_back(g);
+    }
+  } else {
+    std::stringstream list(spec);
+    std::string name;
+    while (std::getline(list, name, ',')) {
+      const int g = mj_name2id(m, mjOBJ_GEOM, name.c_str());
+      const int b = mj_name2id(m, mjOBJ_BODY, name.c_str());
+      if (g < 0 && b < 0) {
+        *error = "key 'contact': no geom or body named '" + name + "' in the model";
+        return false;
+      }
+      if (g >= 0) {
+        if (!Supported(m->geom_type[g])) {
+          *error = "key 'contact': geom '" + name + "' is a " + TypeName(m->geom_type[g]) +
+                   "; supported: plane, sphere, capsule, cylinder, box, ellipsoid";
+          return false;
+        }
+        geoms.push_back(g);
+      } else {
+        for (int k = 0; k < m->body_geomnum[b]; ++k) {
+          const int gk = m->body_geomadr[b] + k;
+          if (Supported(m->geom_type[gk])) {
+            geoms.push_back(gk);
+          } else {
+            warnings->push_back("key 'contact': body '" + name + "' has a " +
+                                TypeName(m->geom_type[gk]) +
+                                " geom, which tether contact does not support yet; it is left "
+                                "out");
+          }
+        }
+      }
+    }
+  }
+  std::sort(geoms.begin(), geoms.end());
+  geoms.erase(std::unique(geoms.begin(), geoms.end()), geoms.end());
+  out->geoms.clear();
+  for (int g : geoms) {
+    ContactGeom cg;
+    cg.geom = g;
+    // A geom on an end's own body: skip it along the arc the tether needs to leave the geom's
+    // bounding sphere from the site (both fixed in the body frame).
+    for (int end = 0; end < 2; ++end) {
+      const int s = site[end];
+      if (s < 0 || m->site_bodyid[s] != m->geom_bodyid[g]) continue;
+      const Vec3 d = Vec3(m->site_pos + 3 * s) - Vec3(m->geom_pos + 3 * g);
+      cg.skip[end] = m->geom_type[g] == mjGEOM_PLANE ? INFINITY : d.norm() + m->geom_rbound[g];
+    }
+    out->geoms.push_back(cg);
+  }
+  out->capacity = 4 * tether.segments() + 16;
+  (void)error;
+  return true;
+}
+
+int FindContacts(const mjModel* m, const mjData* d, const TetherContacts& tc, const Tether& tether,
+                 const double* xp, const double* vp, double dt, double* boxes, ContactPoint* out,
+                 int capacity, int* dropped) {
+  const int N = tether.segments();
+  ConstNodes x(xp, 3, N + 1), v(vp, 3, N + 1);
+  const double r = 0.5 * tether.params().diameter;
+  const double L0 = tether.rest_segment_length();
+  // The margin covers what the tether and a body can close in two steps.
+  double vmax = 0;
+  for (int i = 0; i <= N; ++i) vmax = std::max(vmax, v.col(i).norm());
+  const double reach = r + 2 * dt * vmax + 1e-3 * L0;
+  int count = 0;
+  *dropped = 0;
+  // Boxes of 8 segments (lo, hi: 6 doubles each) and of the whole tether, once per call.
+  const int chunks = (N + kChunk - 1) / kChunk;
+  Vec3 all_lo = x.col(0), all_hi = x.col(0);
+  for (int c = 0; c < chunks; ++c) {
+    const int c0 = c * kChunk, c1 = std::min(N, c0 + kChunk);
+    const Vec3 lo = x.middleCols(c0, c1 - c0 + 1).rowwise().minCoeff();
+    const Vec3 hi = x.middleCols(c0, c1 - c0 + 1).rowwise().maxCoeff();
+    for (int k = 0; k < 3; ++k) boxes[6 * c + k] = lo[k], boxes[6 * c + 3 + k] = hi[k];
+    all_lo = all_lo.cwiseMin(lo);
+    all_hi = all_hi.cwiseMax(hi);
+  }
+  auto apart = [](const Vec3& p, const Vec3& lo, const Vec3& hi, double bound) {
+    return ((p.array() < lo.array() - bound) || (p.array() > hi.array() + bound)).any();
+  };
+  for (const ContactGeom& cg : tc.geoms) {
+    const int g = cg.geom;
+    const int type = m->geom_type[g];
+    const Vec3 pos(d->geom_xpos + 3 * g);
+    const Eigen::Map<const RowMat3> R(d->geom_xmat + 9 * g);
+    const double* sz = m->geom_size + 3 * g;
+    const bool plane = type == mjGEOM_PLANE;
+    // Velocity of the geom's body: twist at the geom's centre (a mocap body moved by a
+    // motion: declaration has its prescribed velocity; another mocap body none).
+    // Geoms welded to the world (scenery) have none, without asking.
+    const int body = m->geom_bodyid[g];
+    Vec3 w = Vec3::Zero(), vg = Vec3::Zero();
+    if (m->body_mocapid[body] >= 0) {
+      PrescribedVelocity(m, d, body, &vg);
+    } else if (m->body_weldid[body] != 0) {
+      mjtNum twist[6];
+      mj_objectVelocity(m, d, mjOBJ_GEOM, g, twist, 0);
+      w = Vec3(twist[0], twist[1], twist[2]);
+      vg = Vec3(twist[3], twist[4], twist[5]);
+    }
+    const double margin = reach + 2 * dt * (vg.norm() + w.norm() * m->geom_rbound[g]);
+    const double bound = m->geom_rbound[g] + margin;
+    if (!plane && apart(pos, all_lo, all_hi, bound)) continue;
+    for (int c0 = 0; c0 < N; c0 += kChunk) {
+      const int c1 = std::min(N, c0 + kChunk);
+      const double* box = boxes + 6 * (c0 / kChunk);
+      // Broad phase: the chunk's box against the geom's bounding sphere (a plane: its
+      // signed distance against the chunk's lowest node).
+      if (plane) {
+        const Vec3 nrm = R.col(2);
+        double lowest = INFINITY;
+        for (int i = c0; i <= c1; ++i) lowest = std::min(lowest, nrm.dot(x.col(i) - pos));
+        if (lowest > margin) continue;
+      } else if (apart(pos, Vec3(box), Vec3(box + 3), bound)) {
+        continue;
+      }
+      for (int j = c0; j < c1; ++j) {
+        if (j * L0 < cg.skip[0] || (N - j - 1) * L0 < cg.skip[1]) continue;
+        const Vec3 a = x.col(j), b = x.col(j + 1);
+        if (!plane) {
+          if (apart(pos, a.cwiseMin(b), a.cwiseMax(b), bound)) continue;
+        }
+        // Narrow phase in the geom's frame.
+        const Closest c =
+            SegmentGeom(type, sz, R.transpose() * (a - pos), R.transpose() * (b - pos));
+        if (!(c.dist < margin)) continue;
+        if (count == capacity) {
+          ++*dropped;
+          continue;
+        }
+        ContactPoint& cp = *new (out + count++) ContactPoint();
+        cp.segment = j;
+        cp.s = c.s;
+        cp.point = pos + R * c.surface;
+        cp.normal = R * c.normal;
+        cp.velocity = vg + w.cross(cp.point - pos);
+        cp.impulse.setZero();
+        cp.stage.setZero();
+        cp.tag = body;
+      }
+    }
+  }
+  return count;
+}
+
+}  // namespace mjtether

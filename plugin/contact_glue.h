@@ -1,0 +1,47 @@
+// Internal glue between plugin.cc and tether-geom contact (plugin/contact_glue.cc,
+// docs/contact.md). Not part of the public API.
+#ifndef MJTETHER_PLUGIN_CONTACT_GLUE_H_
+#define MJTETHER_PLUGIN_CONTACT_GLUE_H_
+
+#include <mujoco/mujoco.h>
+
+#include <string>
+#include <vector>
+
+#include "contact.h"
+#include "tether.h"
+
+namespace mjtether {
+
+// One geom a tether may touch, with the arc lengths from end A and end B [m] within which its
+// segments skip it (the geom is on that end's body: the tether starts inside or against it).
+struct ContactGeom {
+  int geom = -1;
+  double skip[2] = {0, 0};
+};
+
+struct TetherContacts {
+  std::vector<ContactGeom> geoms;
+  int capacity = 0;  // candidates per step (4 per segment + 16); more are dropped and counted
+};
+
+// Resolves `contact=` ("all" or geom/body names) for a tether whose end sites are site[0],
+// site[1] (-1: free). Supported geom types: plane, sphere, capsule, cylinder, box, ellipsoid.
+// A named mesh or hfield is an error; under `all` they are left out with a warning.
+bool ResolveContactGeoms(const mjModel* m, const std::string& spec, const int site[2],
+                         const Tether& tether, TetherContacts* out,
+                         std::vector<std::string>* warnings, std::string* error);
+
+// The candidates of one step [t, t + dt]: every segment point of the state x (3 x n) within a
+// margin of a geom as it is in d (broad phase on bounding spheres against 8-segment boxes,
+// then the segment-geom closest points). Writes at most `capacity` into out; returns the
+// count, and sets *dropped to the number left out. `boxes` is scratch of ChunkBoxesSize
+// doubles. Allocates nothing.
+int FindContacts(const mjModel* m, const mjData* d, const TetherContacts& tc, const Tether& tether,
+                 const double* x, const double* v, double dt, double* boxes, ContactPoint* out,
+                 int capacity, int* dropped);
+inline int ChunkBoxesSize(int segments) { return 6 * (segments / 8 + 1); }
+
+}  // namespace mjtether
+
+#endif  // MJTETHER_PLUGIN_CONTACT_GLUE_H_
