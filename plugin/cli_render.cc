@@ -183,7 +183,7 @@ int Render(const RenderCliOptions& opt) {
   if (!renderer) {
     std::cerr << "mjtether: " << opt.model << ": " << error << "\n";
     return error.rfind("OSMesa", 0) == 0 || error.rfind("MuJoCo", 0) == 0 ? kExitTool
-                                                                         : kExitBadInput;
+                                                                          : kExitBadInput;
   }
   const int W = ropt.width, H = ropt.height;
 
@@ -217,7 +217,8 @@ int Render(const RenderCliOptions& opt) {
     for (; step < target; ++step) {
       if (const int signal = StopSignal()) {
         std::cerr << (progress ? "\n" : "") << "mjtether: " << opt.model << ": "
-                  << Interrupted(signal, d->time, step, mjtether::render::FrameStep(nframes - 1, opt.fps, h))
+                  << Interrupted(signal, d->time, step,
+                                 mjtether::render::FrameStep(nframes - 1, opt.fps, h))
                   << "; the video keeps " << frame_ms.size() << " frame(s)\n";
         status = 128 + signal;
         break;

@@ -153,9 +153,10 @@ int Run(const RunOptions& opt) {
     }
     if (i == steps) break;
     if (const int signal = StopSignal()) {
-      std::cerr << "mjtether: " << opt.model << ": "
-                << Interrupted(signal, d->time, i, steps);
-      if (rows > 0) std::cerr << "; the outputs keep " << rows << " sample(s) up to t = " << last_row_time << " s";
+      std::cerr << "mjtether: " << opt.model << ": " << Interrupted(signal, d->time, i, steps);
+      if (rows > 0)
+        std::cerr << "; the outputs keep " << rows << " sample(s) up to t = " << last_row_time
+                  << " s";
       std::cerr << "\n";
       status = 128 + signal;
       break;

@@ -24,8 +24,8 @@ inline std::optional<std::string> StepAndCheck(const mjModel* m, mjData* d,
   if (std::optional<std::string> diverged = mjtether::CheckDivergence(m, d)) return diverged;
   if (d->warning[mjWARN_BADQACC].number > bad_before) {
     std::ostringstream s;
-    s << model << ": MuJoCo found a bad acceleration in the step from t = " << t0
-      << " s (dof " << d->warning[mjWARN_BADQACC].lastinfo
+    s << model << ": MuJoCo found a bad acceleration in the step from t = " << t0 << " s (dof "
+      << d->warning[mjWARN_BADQACC].lastinfo
       << ") and reset the simulation; reduce <option timestep> (now " << m->opt.timestep
       << " s) or use a stiffer-safe integrator (implicit tether, RK4 for the bodies)";
     return s.str();

@@ -13,9 +13,9 @@
 #include <vector>
 
 #include "declaration.h"
+#include "mjtether.h"
 #include "model_files.h"
 #include "text_check.h"
-#include "mjtether.h"
 #include "vehicle_glue.h"
 
 namespace mjtether {

@@ -1,11 +1,11 @@
 #include "declaration.h"
 
-#include "text_check.h"
-
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
+
+#include "text_check.h"
 
 namespace mjtether {
 namespace {
@@ -49,12 +49,14 @@ bool ParseInRange(const std::string& key, const std::string& text, const Range& 
     return Fail(error, key,
                 "key '" + key + "' = " + Shown(text) +
                     " is out of range (below 2.2e-308 in magnitude; write 0 or a larger number); "
-                    "allowed: " + range.Describe());
+                    "allowed: " +
+                    range.Describe());
   }
   if (!ParseNumber(key, text, &x, error)) return false;
   if (!range.Contains(x)) {
-    return Fail(error, key,
-                "key '" + key + "' = " + Shown(text) + " is out of range; allowed: " + range.Describe());
+    return Fail(
+        error, key,
+        "key '" + key + "' = " + Shown(text) + " is out of range; allowed: " + range.Describe());
   }
   *value = x;
   return true;
@@ -65,8 +67,9 @@ bool ParseInteger(const std::string& key, const std::string& text, const Range& 
   double x;
   if (!ParseInRange(key, text, range, &x, error)) return false;
   if (x != std::floor(x)) {
-    return Fail(error, key, "key '" + key + "' = " + Shown(text) + " must be a whole number in " +
-                                range.Describe());
+    return Fail(
+        error, key,
+        "key '" + key + "' = " + Shown(text) + " must be a whole number in " + range.Describe());
   }
   *value = static_cast<int>(x);
   return true;
@@ -90,7 +93,8 @@ bool ParseVector(const std::string& key, const std::string& text, Vec3* v,
   for (int i = 0; i < 3; ++i) {
     if (!ParseNumber(key, items[i], &(*v)[i], error)) return false;
     if (!(std::abs((*v)[i]) <= 1e3)) {
-      return Fail(error, key, "key '" + key + "' = " + Shown(text) + ": each component in [-1000, 1000]");
+      return Fail(error, key,
+                  "key '" + key + "' = " + Shown(text) + ": each component in [-1000, 1000]");
     }
   }
   return true;
@@ -225,12 +229,14 @@ std::optional<unsigned> ResolveEffects(const TetherParams& p, const Environment&
       if (name == kEffectNames[i]) found = i;
     }
     if (found < 0) {
-      Fail(error, "effects", "key 'effects': unknown effect '" + Shown(name) + "'; allowed: " +
-                                 EffectsToString((1u << kNumEffects) - 1));
+      Fail(error, "effects",
+           "key 'effects': unknown effect '" + Shown(name) +
+               "'; allowed: " + EffectsToString((1u << kNumEffects) - 1));
       return std::nullopt;
     }
     if (!needs[found].available) {
-      Fail(error, "effects", "key 'effects': effect '" + Shown(name) + "' needs " + needs[found].missing);
+      Fail(error, "effects",
+           "key 'effects': effect '" + Shown(name) + "' needs " + needs[found].missing);
       return std::nullopt;
     }
     effects |= 1u << found;
@@ -274,8 +280,10 @@ std::optional<TetherDeclaration> ParseTether(const std::string& text, const Envi
     if (key == "ends") {
       std::vector<std::string> sites = SplitList(value);
       if (sites.size() != 2 || sites[0].empty() || sites[1].empty()) {
-        ok = Fail(error, key, "key 'ends' = " + Shown(value) + " must be two site names A,B (B may be "
-                              "'free')");
+        ok = Fail(error, key,
+                  "key 'ends' = " + Shown(value) +
+                      " must be two site names A,B (B may be "
+                      "'free')");
       } else if (sites[0] == "free") {
         ok = Fail(error, key, "key 'ends': end A must be a site; only end B may be 'free'");
       } else if (sites[0] == sites[1]) {
@@ -317,8 +325,9 @@ std::optional<TetherDeclaration> ParseTether(const std::string& text, const Envi
       } else if (value == "rk4") {
         p.integrator = Integrator::kRK4;
       } else {
-        ok = Fail(error, key,
-                  "key 'integrator' = " + Shown(value) + "; allowed: explicit, implicit, implicit2, rk4");
+        ok = Fail(
+            error, key,
+            "key 'integrator' = " + Shown(value) + "; allowed: explicit, implicit, implicit2, rk4");
       }
     } else if (key == "bending") {
       if (value == "galerkin") {

@@ -1,12 +1,12 @@
 #include "motion.h"
 
-#include "text_check.h"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
+
+#include "text_check.h"
 
 namespace mjtether {
 namespace {
@@ -67,8 +67,8 @@ std::optional<Motion> Motion::Create(const MotionParams& params, const std::stri
       for (int i = 1; i < 4; ++i) {
         if (!(std::abs(v[i]) <= kMaxTableOffset)) {
           std::ostringstream o;
-          o << "key 'csv': " << csv_path << " line " << row << ": offset " << "xyz"[i - 1] << " = "
-            << v[i] << " m outside [-10000, 10000]";
+          o << "key 'csv': " << csv_path << " line " << row << ": offset "
+            << "xyz"[i - 1] << " = " << v[i] << " m outside [-10000, 10000]";
           return fail(o.str());
         }
       }

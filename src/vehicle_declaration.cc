@@ -1,12 +1,12 @@
 #include "vehicle_declaration.h"
 
-#include "text_check.h"
-
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
 #include <vector>
+
+#include "text_check.h"
 
 namespace mjtether {
 namespace {
@@ -43,14 +43,16 @@ bool ParseList(const std::string& key, const std::string& text, int count, doubl
       return Fail(error, key,
                   "key '" + key + "' = " + Shown(text) +
                       ": a value is out of range (below 2.2e-308 in magnitude; write 0 or a "
-                      "larger number); each value in " + range);
+                      "larger number); each value in " +
+                      range);
     }
     if (status != NumberStatus::kOk) {
       return Fail(error, key, "key '" + key + "': '" + Shown(it) + "' " + NumberProblem(status));
     }
     if (!((lo_open ? x > lo : x >= lo) && x <= hi)) {
-      return Fail(error, key,
-                  "key '" + key + "' = " + Shown(text) + ": each value in " + range + " (" + what + ")");
+      return Fail(
+          error, key,
+          "key '" + key + "' = " + Shown(text) + ": each value in " + range + " (" + what + ")");
     }
     out->push_back(x);
   }
