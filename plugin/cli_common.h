@@ -298,12 +298,13 @@ class OutputFile {
     return true;
   }
   bool is_open() const { return fd_ >= 0; }
+  bool failed() const { return failed_; }
 
   // Appends complete rows (each ending with '\n').
   void Write(const std::string& rows) {
     if (fd_ < 0 || failed_) return;
     buffer_ += rows;
-    if (buffer_.size() >= (1u << 20)) Flush();
+    if (buffer_.size() >= (1u << 16)) Flush();
   }
 
   // Writes the buffer; false (and the file cut back to its last complete row) on failure.

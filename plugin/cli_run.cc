@@ -149,7 +149,7 @@ int Run(const RunOptions& opt) {
       sample();
       ++sample_index;
       next_sample = std::llround(sample_index * every / h);
-      if (!log.Flush() || !nodes.Flush()) break;  // a write failed: reported below (exit 5)
+      if (log.failed() || nodes.failed()) break;  // a write failed: reported below (exit 5)
     }
     if (i == steps) break;
     if (const int signal = StopSignal()) {
