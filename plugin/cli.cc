@@ -2,7 +2,8 @@
 // registers itself (cli_command.h).
 //
 // Exit codes: 0 success, 1 the simulation diverged, 2 bad input (model, declaration or
-// options), 3 MuJoCo error, 4 an external tool failed.
+// options), 3 MuJoCo error, 4 an external tool failed, 5 an output could not be written
+// (docs/bad_input.md), 130/143 stopped by SIGINT/SIGTERM (the outputs keep complete rows).
 #include <functional>
 #include <vector>
 

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "cli_command.h"
+#include "cli_common.h"
 #include "cli_pipe.h"
 #include "cli_plot_columns.h"
 #include "cli_step.h"
@@ -52,11 +53,7 @@ bool EndsWith(const std::string& s, const std::string& suffix) {
 }
 
 std::vector<std::string> SplitCsv(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream ss(line);
-  std::string item;
-  while (std::getline(ss, item, ',')) out.push_back(item);
-  return out;
+  return mjtether::SplitCsvLine(line);  // RFC 4180: quoted names may hold commas
 }
 
 // Reads a run log. Returns false with *error naming the file and the missing column.
@@ -100,15 +97,25 @@ bool ReadLog(const PlotOptions& opt, Series* s, std::string* error) {
     ++row;
     if (line.empty()) continue;
     const std::vector<std::string> v = SplitCsv(line);
-    try {
-      s->t.push_back(std::stod(v.at(ct)));
-      s->ta.push_back(std::stod(v.at(ca)));
-      s->tb.push_back(std::stod(v.at(cb)));
-      s->z.push_back(cz < n ? std::stod(v.at(cz)) : 0.0);
-    } catch (const std::exception&) {
-      *error = opt.input + ": line " + std::to_string(row) + ": not a number in a needed column";
-      return false;
+    double value[4] = {0, 0, 0, 0};
+    const int columns[4] = {ct, ca, cb, cz < n ? cz : -1};
+    for (int c = 0; c < 4; ++c) {
+      if (columns[c] < 0) continue;
+      const std::string field =
+          columns[c] < static_cast<int>(v.size()) ? v[columns[c]] : std::string("(missing)");
+      const mjtether::NumberStatus status = mjtether::ParseDecimal(field, &value[c]);
+      if (status != mjtether::NumberStatus::kOk || !(std::abs(value[c]) <= 1e15)) {
+        *error = opt.input + ": line " + std::to_string(row) + ", column '" +
+                 mjtether::Shown(head[columns[c]]) + "': '" + mjtether::Shown(field) + "' " +
+                 (status == mjtether::NumberStatus::kOk ? "is out of range [-1e15, 1e15]"
+                                                        : mjtether::NumberProblem(status));
+        return false;
+      }
     }
+    s->t.push_back(value[0]);
+    s->ta.push_back(value[1]);
+    s->tb.push_back(value[2]);
+    s->z.push_back(value[3]);
   }
   return true;
 }
@@ -120,32 +127,27 @@ std::string BodyName(const mjModel* m, int b) {
 }
 
 // Runs the model and samples it. Returns 0, or the exit code (1 diverged, 2 bad input).
-int RunModel(const PlotOptions& opt, Series* s) {
-  std::string error;
-  mjModel* m = mjtether::LoadModel(opt.input, &error);
-  if (!m) {
-    std::cerr << "mjtether: " << error << "\n";
-    return 2;
-  }
+// Runs the model and samples it. Returns 0, or the exit code (1 diverged, 2 bad input,
+// 128 + signal when interrupted: the samples so far are plotted).
+int RunModel(const PlotOptions& opt, const mjModel* m, Series* s) {
+  using namespace mjtether::cli;
   int status = 0;
   const int k = opt.tether.empty() ? 0 : mjtether::FindTether(m, opt.tether);
   int vehicle =
       opt.body.empty() ? mjtether::render::Vehicle(m) : mj_name2id(m, mjOBJ_BODY, opt.body.c_str());
   if (mjtether::TetherCount(m) == 0 || k < 0) {
     std::cerr << "mjtether: " << opt.input << ": "
-              << (k < 0 ? "no tether named '" + opt.tether + "'" : "no tether declared") << "\n";
-    status = 2;
+              << (k < 0 ? "no tether named '" + mjtether::Shown(opt.tether) + "'"
+                        : "no tether declared")
+              << "\n";
+    return kExitBadInput;
   } else if (!opt.body.empty() && vehicle < 0) {
-    std::cerr << "mjtether: " << opt.input << ": --body " << opt.body << ": no such body\n";
-    status = 2;
+    std::cerr << "mjtether: " << opt.input << ": --body " << mjtether::Shown(opt.body)
+              << ": no such body\n";
+    return kExitBadInput;
   } else if (!(opt.duration > 0)) {
     std::cerr << "mjtether: plot " << opt.input << ": give --duration S to run the model\n";
-    status = 2;
-  }
-  if (status) {
-    mjtether::Detach(m);
-    mj_deleteModel(m);
-    return status;
+    return kExitBadInput;
   }
   const std::string name = mjtether::TetherName(m, k);
   s->title = name + " (" + opt.input + ")";
@@ -153,31 +155,41 @@ int RunModel(const PlotOptions& opt, Series* s) {
   s->label_b = name + ": tension at " + BodyName(m, mjtether::EndBody(m, k, 1));
   s->vehicle = vehicle >= 0 ? BodyName(m, vehicle) : "";
 
-  mjData* d = mj_makeData(m);
+  DataPtr data = MakeData(m);
+  mjData* d = data.get();
+  Observer observer(m);
   const double h = m->opt.timestep;
   const long long steps = std::llround(opt.duration / h);
+  if (opt.every < h) {
+    std::cerr << "mjtether: warning: --every " << opt.every << " s is below the time step " << h
+              << " s: sampling every step\n";
+  }
   const double every = std::max(opt.every, h);
   long long next = 0, index = 0;
   for (long long i = 0;; ++i) {
     if (i == next) {
-      mj_forward(m, d);
-      const mjtether::EndReactions r = mjtether::GetReactions(m, d, k);
-      s->t.push_back(d->time);
+      mjtether::Prescribe(m, d);
+      const mjData* o = observer.Observe(d);
+      const mjtether::EndReactions r = mjtether::GetReactions(m, o, k);
+      s->t.push_back(o->time);
       s->ta.push_back(r.tension_a);
       s->tb.push_back(r.tension_b);
-      s->z.push_back(vehicle >= 0 ? d->xpos[3 * vehicle + 2] : 0.0);
+      s->z.push_back(vehicle >= 0 ? o->xpos[3 * vehicle + 2] : 0.0);
       next = std::llround(++index * every / h);
     }
     if (i == steps) break;
-    if (std::optional<std::string> diverged = mjtether::cli::StepAndCheck(m, d, opt.input)) {
+    if (const int signal = StopSignal()) {
+      std::cerr << "mjtether: " << opt.input << ": " << Interrupted(signal, d->time, i, steps)
+                << "; plotting the " << s->t.size() << " sample(s) so far\n";
+      status = 128 + signal;
+      break;
+    }
+    if (std::optional<std::string> diverged = StepAndCheck(m, d, opt.input)) {
       std::cerr << "mjtether: " << *diverged << "\n";
-      status = 1;
+      status = kExitDiverged;
       break;
     }
   }
-  mj_deleteData(d);
-  mjtether::Detach(m);
-  mj_deleteModel(m);
   return status;
 }
 
@@ -200,19 +212,38 @@ int Plot(const PlotOptions& opt) {
   if (!opt.x.empty() || !opt.y.empty()) {
     return mjtether::cli::PlotColumns({opt.input, opt.x, opt.y, opt.by, opt.out, W, H});
   }
+  using namespace mjtether::cli;
+  InstallStopHandlers();
+  // The input (and a model's own files) may not be overwritten by --out.
+  OutputGuard guard;
   Series s;
+  ModelPtr model;
+  int run_status = 0;
   if (EndsWith(opt.input, ".csv")) {
+    guard.AddInput(opt.input, "the input");
     std::string error;
     if (!ReadLog(opt, &s, &error)) {
       std::cerr << "mjtether: " << error << "\n";
-      return 2;
+      return kExitBadInput;
     }
-  } else if (const int status = RunModel(opt, &s); status != 0) {
-    return status;
+  } else {
+    model = LoadChecked(opt.input);
+    if (!model) return kExitBadInput;
+    guard.AddModel(opt.input, model.get());
+  }
+  ToolOutput out;
+  std::string out_error;
+  if (!out.Open(opt.out, "--out", &guard, &out_error)) {
+    std::cerr << "mjtether: " << out_error << "\n";
+    return kExitBadInput;
+  }
+  if (model) {
+    run_status = RunModel(opt, model.get(), &s);
+    if (run_status != 0 && run_status < 128) return run_status;
   }
   if (s.t.empty()) {
     std::cerr << "mjtether: " << opt.input << ": no samples to plot\n";
-    return 2;
+    return kExitBadInput;
   }
 
   // Two panels sharing the time axis: end tensions, then the vehicle's depth (-z, downwards).
@@ -224,7 +255,7 @@ int Plot(const PlotOptions& opt) {
   }
   g << "EOD\n"
     << "set terminal pngcairo size " << W << "," << H << " font 'sans,11'\n"
-    << "set output " << Quote(opt.out) << "\n"
+    << "set output " << Quote(out.path()) << "\n"
     << "set multiplot layout " << (s.vehicle.empty() ? 1 : 2) << ",1 title " << Quote(s.title)
     << " noenhanced\n"
     << "set grid\nset key top right noenhanced\nset lmargin 12\n"
@@ -248,15 +279,19 @@ int Plot(const PlotOptions& opt) {
   }
   const bool written = gnuplot.Write(g.str());
   const int rc = gnuplot.Close();
-  std::ifstream png(opt.out, std::ios::binary | std::ios::ate);
+  std::ifstream png(out.path(), std::ios::binary | std::ios::ate);
   if (!written || rc != 0 || !png || png.tellg() <= 0) {
     std::cerr << "mjtether: gnuplot failed (exit status " << rc
               << (rc == 127 ? ": gnuplot not found on PATH" : "") << ") writing " << opt.out
               << "\n";
-    return 4;
+    return kExitTool;
+  }
+  if (!out.Commit(&out_error)) {
+    std::cerr << "mjtether: " << out_error << "\n";
+    return kExitOutput;
   }
   std::cerr << "mjtether: plotted " << s.t.size() << " samples to " << opt.out << "\n";
-  return 0;
+  return run_status;
 }
 
 std::function<int()> SetupPlot(CLI::App* sub) {
@@ -266,9 +301,9 @@ std::function<int()> SetupPlot(CLI::App* sub) {
       ->check(CLI::ExistingFile);
   sub->add_option("--out", opt->out, "PNG file to write")->required();
   sub->add_option("--duration", opt->duration, "simulated time when INPUT is a model [s]")
-      ->check(CLI::Range(0.0, 1e7));
+      ->check(mjtether::cli::Number(0, 1e7, false, "s"));
   sub->add_option("--every", opt->every, "sampling interval when INPUT is a model [s]")
-      ->check(CLI::Range(1e-9, 1e7));
+      ->check(mjtether::cli::Number(0, 1e7, true, "s"));
   sub->add_option("--tether", opt->tether, "tether to plot (default: the first)");
   sub->add_option("--body", opt->body, "body whose depth is plotted (default: the vehicle)");
   sub->add_option("--size", opt->size, "WIDTHxHEIGHT in pixels (default 1000x700)");

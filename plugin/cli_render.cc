@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "cli_command.h"
+#include "cli_common.h"
 #include "cli_pipe.h"
 #include "cli_step.h"
 #include "mjtether.h"
@@ -57,7 +58,9 @@ bool ParseSize(const std::string& s, int* w, int* h) {
 // before rendering. Returns nullopt if the simulation diverges (the message is printed).
 std::optional<double> TensionPrepass(const mjModel* m, const std::string& model, long long nframes,
                                      double fps) {
-  mjData* d = mj_makeData(m);
+  mjtether::cli::DataPtr data = mjtether::cli::MakeData(m);
+  mjData* d = data.get();
+  mjtether::cli::Observer observer(m);
   const double h = m->opt.timestep;
   std::vector<double> T;
   double tmax = 0;
@@ -65,24 +68,24 @@ std::optional<double> TensionPrepass(const mjModel* m, const std::string& model,
   long long step = 0;
   for (long long k = 0; k < nframes && ok; ++k) {
     const long long target = mjtether::render::FrameStep(k, fps, h);
-    for (; step < target; ++step) {
+    for (; step < target && !mjtether::cli::StopSignal(); ++step) {
       if (std::optional<std::string> diverged = mjtether::cli::StepAndCheck(m, d, model)) {
         std::cerr << "mjtether: " << *diverged << "\n";
         ok = false;
         break;
       }
     }
-    if (!ok) break;
-    mj_forward(m, d);
+    if (!ok || mjtether::cli::StopSignal()) break;
+    mjtether::Prescribe(m, d);
+    const mjData* o = observer.Observe(d);
     for (int t = 0; t < mjtether::TetherCount(m); ++t) {
       T.resize(mjtether::GetTether(m, t)->segments());
-      mjtether::GetTensions(m, d, t, T.data());
+      mjtether::GetTensions(m, o, t, T.data());
       for (double x : T) tmax = std::max(tmax, x);
-      const mjtether::EndReactions r = mjtether::GetReactions(m, d, t);
+      const mjtether::EndReactions r = mjtether::GetReactions(m, o, t);
       tmax = std::max({tmax, r.tension_a, r.tension_b});
     }
   }
-  mj_deleteData(d);
   if (!ok) return std::nullopt;
   return tmax;
 }
@@ -99,33 +102,31 @@ void Progress(long long done, long long total, double t, double elapsed) {
 
 int Render(const RenderCliOptions& opt) {
   namespace fs = std::filesystem;
+  using namespace mjtether::cli;
+  InstallStopHandlers();
   mjtether::render::RenderOptions ropt;
   if (!ParseSize(opt.size, &ropt.width, &ropt.height)) {
-    std::cerr << "mjtether: --size " << opt.size << ": expected WIDTHxHEIGHT, e.g. 1280x720\n";
-    return 2;
+    std::cerr << "mjtether: --size " << mjtether::Shown(opt.size)
+              << ": expected WIDTHxHEIGHT, e.g. 1280x720\n";
+    return kExitBadInput;
   }
   if (opt.video.empty() && opt.png_every.empty()) {
     std::cerr << "mjtether: render: nothing to write; give --video FILE.mp4 and/or --png-every "
                  "S DIR\n";
-    return 2;
+    return kExitBadInput;
   }
   double png_every = 0;
   std::string png_dir;
   if (!opt.png_every.empty()) {
-    char* end = nullptr;
-    png_every = std::strtod(opt.png_every[0].c_str(), &end);
-    if (end == opt.png_every[0].c_str() || *end || !(png_every > 0) || png_every > 1e7) {
-      std::cerr << "mjtether: --png-every " << opt.png_every[0]
-                << ": interval must be a number of seconds in (0, 1e7]\n";
-      return 2;
+    const mjtether::NumberStatus number = mjtether::ParseDecimal(opt.png_every[0], &png_every);
+    if (number != mjtether::NumberStatus::kOk || !(png_every > 0) || png_every > 1e7) {
+      std::cerr << "mjtether: --png-every " << mjtether::Shown(opt.png_every[0]) << ": "
+                << (number == mjtether::NumberStatus::kOk ? "out of range"
+                                                          : mjtether::NumberProblem(number))
+                << "; the interval must be a number of seconds in (0, 1e7]\n";
+      return kExitBadInput;
     }
     png_dir = opt.png_every[1];
-    std::error_code ec;
-    fs::create_directories(png_dir, ec);
-    if (ec || !fs::is_directory(png_dir)) {
-      std::cerr << "mjtether: --png-every: cannot create directory " << png_dir << "\n";
-      return 2;
-    }
   }
   ropt.samples = opt.samples;
   ropt.camera = opt.camera;
@@ -134,18 +135,27 @@ int Render(const RenderCliOptions& opt) {
   ropt.hud = !opt.no_hud;
 
   std::string error;
-  mjModel* m = mjtether::LoadModel(opt.model, &error);
-  if (!m) {
+  ModelPtr owner = LoadChecked(opt.model);
+  if (!owner) return kExitBadInput;
+  mjModel* m = owner.get();
+
+  // Outputs: the video goes to a temporary file beside its target (renamed when ffmpeg is
+  // done); each still is checked against the inputs as it is written.
+  OutputGuard guard;
+  guard.AddModel(opt.model, m);
+  ToolOutput video;
+  if (!opt.video.empty() && !video.Open(opt.video, "--video", &guard, &error)) {
     std::cerr << "mjtether: " << error << "\n";
-    return 2;
+    return kExitBadInput;
   }
-  struct Cleanup {
-    mjModel* m;
-    ~Cleanup() {
-      mjtether::Detach(m);
-      mj_deleteModel(m);
+  if (!png_dir.empty()) {
+    std::error_code ec;
+    fs::create_directories(png_dir, ec);
+    if (ec || !fs::is_directory(png_dir)) {
+      std::cerr << "mjtether: --png-every: cannot create directory " << png_dir << "\n";
+      return kExitBadInput;
     }
-  } cleanup{m};
+  }
 
   const double h = m->opt.timestep;
   const double frame_dt = 1.0 / opt.fps;
@@ -158,7 +168,13 @@ int Render(const RenderCliOptions& opt) {
     ropt.tension_max = opt.tension_max;
   } else {
     std::optional<double> tmax = TensionPrepass(m, opt.model, nframes, opt.fps);
-    if (!tmax) return 1;
+    if (!tmax) return kExitDiverged;
+    if (const int signal = StopSignal()) {
+      std::cerr << "mjtether: " << opt.model << ": interrupted by "
+                << (signal == SIGINT ? "SIGINT" : "SIGTERM")
+                << " during the tension pre-pass; nothing was written\n";
+      return 128 + signal;
+    }
     ropt.tension_max = mjtether::render::NiceCeil(*tmax);
   }
 
@@ -166,7 +182,8 @@ int Render(const RenderCliOptions& opt) {
       mjtether::render::Renderer::Create(m, ropt, &error);
   if (!renderer) {
     std::cerr << "mjtether: " << opt.model << ": " << error << "\n";
-    return error.rfind("OSMesa", 0) == 0 || error.rfind("MuJoCo", 0) == 0 ? 4 : 2;
+    return error.rfind("OSMesa", 0) == 0 || error.rfind("MuJoCo", 0) == 0 ? kExitTool
+                                                                          : kExitBadInput;
   }
   const int W = ropt.width, H = ropt.height;
 
@@ -174,18 +191,20 @@ int Render(const RenderCliOptions& opt) {
   const std::string size = std::to_string(W) + "x" + std::to_string(H);
   char rate[32];
   std::snprintf(rate, sizeof(rate), "%.9g", opt.fps * opt.speedup);  // playback frame rate
-  mjtether::cli::ChildPipe ffmpeg;
+  ChildPipe ffmpeg;
   if (!opt.video.empty() &&
       !ffmpeg.Open({"ffmpeg",   "-hide_banner", "-loglevel", "error", "-y",    "-f",
                     "rawvideo", "-pix_fmt",     "rgb24",     "-s",    size,    "-r",
                     rate,       "-i",           "-",         "-vf",   "vflip", "-c:v",
-                    "libx264",  "-pix_fmt",     "yuv420p",   "-r",    rate,    opt.video},
+                    "libx264",  "-pix_fmt",     "yuv420p",   "-r",    rate,    video.path()},
                    &error)) {
     std::cerr << "mjtether: cannot start ffmpeg: " << error << "\n";
-    return 4;
+    return kExitTool;
   }
 
-  mjData* d = mj_makeData(m);
+  DataPtr data = MakeData(m);
+  mjData* d = data.get();
+  Observer observer(m);
   std::vector<unsigned char> rgb(static_cast<size_t>(3) * W * H);
   const bool progress = isatty(2);
   std::vector<double> frame_ms;
@@ -196,9 +215,17 @@ int Render(const RenderCliOptions& opt) {
     // Frame k at step round(k / (fps h)).
     const long long target = mjtether::render::FrameStep(k, opt.fps, h);
     for (; step < target; ++step) {
-      if (std::optional<std::string> diverged = mjtether::cli::StepAndCheck(m, d, opt.model)) {
+      if (const int signal = StopSignal()) {
+        std::cerr << (progress ? "\n" : "") << "mjtether: " << opt.model << ": "
+                  << Interrupted(signal, d->time, step,
+                                 mjtether::render::FrameStep(nframes - 1, opt.fps, h))
+                  << "; the video keeps " << frame_ms.size() << " frame(s)\n";
+        status = 128 + signal;
+        break;
+      }
+      if (std::optional<std::string> diverged = StepAndCheck(m, d, opt.model)) {
         std::cerr << (progress ? "\n" : "") << "mjtether: " << *diverged << "\n";
-        status = 1;
+        status = kExitDiverged;
         break;
       }
     }
@@ -207,22 +234,30 @@ int Render(const RenderCliOptions& opt) {
     const bool still = png_every > 0 && k >= std::llround(next_png * png_every * opt.fps);
     if (opt.video.empty() && !still) continue;
 
-    mj_forward(m, d);  // the tether at d->time
+    mjtether::Prescribe(m, d);
+    mjData* o = observer.Observe(d);  // the tether at d->time, on a copy
     const auto t0 = std::chrono::steady_clock::now();
-    renderer->Render(m, d, rgb.data());
+    renderer->Render(m, o, rgb.data());
     frame_ms.push_back(
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     if (!opt.video.empty() && !ffmpeg.Write(rgb.data(), rgb.size())) {
-      status = 4;  // ffmpeg stopped reading: its exit status is reported below
+      status = kExitTool;  // ffmpeg stopped reading: its exit status is reported below
       break;
     }
     if (still) {
       char name[64];
       std::snprintf(name, sizeof(name), "t_%09.3f.png", k * frame_dt);
-      if (!mjtether::render::WritePng((fs::path(png_dir) / name).string(), rgb.data(), W, H,
-                                      &error)) {
+      const std::string path = (fs::path(png_dir) / name).string();
+      ToolOutput png;
+      if (!png.Open(path, "--png-every", &guard, &error)) {
         std::cerr << (progress ? "\n" : "") << "mjtether: " << error << "\n";
-        status = 2;
+        status = kExitBadInput;
+        break;
+      }
+      if (!mjtether::render::WritePng(png.path(), rgb.data(), W, H, &error) ||
+          !png.Commit(&error)) {
+        std::cerr << (progress ? "\n" : "") << "mjtether: output error: " << error << "\n";
+        status = kExitOutput;
         break;
       }
       // Next still: the first one due after this frame (several may fall on one frame when
@@ -236,17 +271,19 @@ int Render(const RenderCliOptions& opt) {
     }
   }
   if (progress) std::fprintf(stderr, "\n");
-  mj_deleteData(d);
 
   if (!opt.video.empty()) {
     const int rc = ffmpeg.Close();
-    if (rc != 0 && (status == 0 || status == 4)) {
+    if (rc != 0 && (status == 0 || status == kExitTool || status >= 128)) {
       std::cerr << "mjtether: ffmpeg failed (exit status " << rc
                 << (rc == 127 ? ": ffmpeg not found on PATH" : "") << ") writing " << opt.video
                 << "\n";
-      status = 4;
-    } else if (status == 4) {
+      if (status < 128) status = kExitTool;
+    } else if (status == kExitTool) {
       std::cerr << "mjtether: ffmpeg stopped reading frames for " << opt.video << "\n";
+    } else if (rc == 0 && !frame_ms.empty() && !video.Commit(&error)) {
+      std::cerr << "mjtether: " << error << "\n";
+      if (status == 0) status = kExitOutput;
     }
   }
   if (status == 0) {
@@ -272,10 +309,10 @@ std::function<int()> SetupRender(CLI::App* sub) {
       ->check(CLI::ExistingFile);
   sub->add_option("--duration", opt->duration, "simulated time [s]")
       ->required()
-      ->check(CLI::Range(0.0, 1e5));
+      ->check(mjtether::cli::Number(0, 1e5, false, "s"));
   sub->add_option("--video", opt->video, "MP4 file (H.264, yuv420p) written by ffmpeg");
   sub->add_option("--fps", opt->fps, "frames per second of simulated time (default 30)")
-      ->check(CLI::Range(0.01, 1000.0));
+      ->check(mjtether::cli::Number(0.01, 1000, false, "frames/s"));
   sub->add_option("--size", opt->size, "WIDTHxHEIGHT in pixels, even numbers (default 1280x720)");
   sub->add_option("--camera", opt->camera,
                   "follow (default), track:BODY, or the name of a <camera> in the model");
@@ -287,15 +324,15 @@ std::function<int()> SetupRender(CLI::App* sub) {
   sub->add_option("--tension-max", opt->tension_max,
                   "top of the tension colour scale [N]; default: the run's largest tension "
                   "rounded up to 1, 2, 3, 4, 5, 6 or 8 x 10^k")
-      ->check(CLI::Range(0.0, 1e12));
+      ->check(mjtether::cli::Number(0, 1e12, false, "N"));
   sub->add_option("--distance", opt->distance,
                   "camera distance for follow and track:BODY [m] (default: 1.25 x the longest "
                   "tether for follow, 15 x the body's radius for track)")
-      ->check(CLI::Range(0.0, 1e6));
+      ->check(mjtether::cli::Number(0, 1e6, false, "m"));
   sub->add_option("--speedup", opt->speedup,
                   "the video plays this many times faster than real time (its frame rate is "
                   "fps x speedup; default 1)")
-      ->check(CLI::Range(0.01, 1000.0));
+      ->check(mjtether::cli::Number(0.01, 1000, false, ""));
   sub->add_option("--vehicle", opt->vehicle, "body whose depth the HUD shows");
   sub->add_flag("--no-hud", opt->no_hud, "no text overlay or colour scale");
   return [opt]() { return Render(*opt); };

@@ -8,11 +8,14 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "cli_command.h"
+#include "cli_common.h"
 #include "cli_run_summary.h"
+#include "cli_step.h"
 #include "declaration.h"
 #include "mjtether.h"
 #include "overrides.h"
@@ -27,6 +30,7 @@ struct RunOptions {
   double every = 0.1;
   std::vector<std::string> set;  // TEXT.KEY=VALUE overrides (overrides.h)
   std::string summary;           // one-row CSV about the whole run (cli_run_summary.h)
+  int digits = 9;  // significant digits of the CSV numbers (17 round-trips a double)
 };
 
 // Bodies with a free joint: the vehicles whose position the log records.
@@ -44,94 +48,112 @@ std::string BodyName(const mjModel* m, int b) {
 }
 
 int Run(const RunOptions& opt) {
-  std::string error;
+  using namespace mjtether::cli;
+  using mjtether::CsvField;
+  InstallStopHandlers();
   std::vector<mjtether::Override> overrides;
   for (const std::string& spec : opt.set) {
-    std::optional<mjtether::Override> o = mjtether::ParseOverride(spec, &error);
+    std::string why;
+    std::optional<mjtether::Override> o = mjtether::ParseOverride(spec, &why);
     if (!o) {
-      std::cerr << "mjtether: --set " << error << "\n";
-      return 2;
+      std::cerr << "mjtether: --set " << why << "\n";
+      return kExitBadInput;
     }
     overrides.push_back(*o);
   }
-  mjModel* m = mjtether::LoadModel(opt.model, overrides, &error);
-  if (!m) {
+  ModelPtr m = LoadChecked(opt.model, overrides);
+  if (!m) return kExitBadInput;
+  // Every output is claimed and opened (as a temporary file) before the run: a bad second path
+  // leaves the first untouched, and no output may be an input or the other output.
+  OutputGuard guard;
+  guard.AddModel(opt.model, m.get());
+  OutputFile log, nodes;
+  std::string error;
+  if ((!opt.log.empty() && !log.Open(opt.log, "--log", &guard, &error)) ||
+      (!opt.nodes.empty() && !nodes.Open(opt.nodes, "--nodes", &guard, &error))) {
     std::cerr << "mjtether: " << error << "\n";
-    return 2;
+    return kExitBadInput;
   }
-  for (const std::string& w : mjtether::Warnings(m)) {
-    std::cerr << "mjtether: warning: " << w << "\n";
+  // --summary is written at the end, but claimed now: it may not be an input or another output.
+  if (!opt.summary.empty() && !guard.Claim(opt.summary, "--summary", &error)) {
+    std::cerr << "mjtether: " << error << "\n";
+    return kExitBadInput;
   }
-  mjData* d = mj_makeData(m);
-  const double h = m->opt.timestep;
-  const std::vector<int> bodies = FreeBodies(m);
-  const int ntether = mjtether::TetherCount(m);
+  DataPtr data = MakeData(m.get());
+  mjData* d = data.get();
+  const mjModel* mm = m.get();
+  const double h = mm->opt.timestep;
+  const std::vector<int> bodies = FreeBodies(mm);
+  const int ntether = mjtether::TetherCount(mm);
+  if (opt.every < h && (log.is_open() || nodes.is_open())) {
+    std::cerr << "mjtether: warning: --every " << opt.every << " s is below the time step " << h
+              << " s: sampling every step\n";
+  }
 
-  std::ofstream log, nodes;
-  if (!opt.log.empty()) {
-    log.open(opt.log);
-    if (!log) {
-      std::cerr << "mjtether: cannot write --log " << opt.log << "\n";
-      return 2;
-    }
-    log << "time";
+  if (log.is_open()) {
+    std::string head = "time";
     for (int b : bodies) {
-      const std::string n = BodyName(m, b);
-      log << "," << n << ".x," << n << ".y," << n << ".z";
+      const std::string n = BodyName(mm, b);
+      for (const char* axis : {".x", ".y", ".z"}) head += "," + CsvField(n + axis);
     }
     for (int k = 0; k < ntether; ++k) {
-      const std::string n = mjtether::TetherName(m, k);
-      log << "," << n << ".tension_A," << n << ".tension_B," << n << ".tension_max," << n
-          << ".slack_segments";
+      const std::string n = mjtether::TetherName(mm, k);
+      for (const char* column : {".tension_A", ".tension_B", ".tension_max", ".slack_segments"}) {
+        head += "," + CsvField(n + column);
+      }
     }
-    log << "\n";
+    log.Write(head + "\n");
   }
-  if (!opt.nodes.empty()) {
-    nodes.open(opt.nodes);
-    if (!nodes) {
-      std::cerr << "mjtether: cannot write --nodes " << opt.nodes << "\n";
-      return 2;
-    }
-    nodes << "time,tether,node,x,y,z,tension\n";
-  }
-  log.precision(9);
-  nodes.precision(9);
+  if (nodes.is_open()) nodes.Write("time,tether,node,x,y,z,tension\n");
 
+  // A sample reads the state at d->time from a copy brought there by mj_forward: the run itself
+  // is the same whatever is logged and how often (Observer).
+  Observer observer(mm);
   std::vector<double> T;
+  long long rows = 0;
+  double last_row_time = 0;
   auto sample = [&]() {
-    mj_forward(m, d);  // brings every tether to d->time (no extra work for the next step)
+    const mjData* o = observer.Observe(d);
+    std::ostringstream row;
+    row.precision(opt.digits);
     if (log.is_open()) {
-      log << d->time;
+      row << o->time;
       for (int b : bodies) {
-        log << "," << d->xpos[3 * b] << "," << d->xpos[3 * b + 1] << "," << d->xpos[3 * b + 2];
+        row << "," << o->xpos[3 * b] << "," << o->xpos[3 * b + 1] << "," << o->xpos[3 * b + 2];
       }
       for (int k = 0; k < ntether; ++k) {
-        const mjtether::EndReactions r = mjtether::GetReactions(m, d, k);
-        T.resize(mjtether::GetTether(m, k)->segments());
-        mjtether::GetTensions(m, d, k, T.data());
+        const mjtether::EndReactions r = mjtether::GetReactions(mm, o, k);
+        T.resize(mjtether::GetTether(mm, k)->segments());
+        mjtether::GetTensions(mm, o, k, T.data());
         double tmax = 0;
         int slack = 0;
         for (double t : T) {
           tmax = std::max(tmax, t);
           slack += t <= 0;
         }
-        log << "," << r.tension_a << "," << r.tension_b << "," << tmax << "," << slack;
+        row << "," << r.tension_a << "," << r.tension_b << "," << tmax << "," << slack;
       }
-      log << "\n";
+      row << "\n";
+      log.Write(row.str());
     }
     if (nodes.is_open()) {
       for (int k = 0; k < ntether; ++k) {
-        const mjtether::Tether* t = mjtether::GetTether(m, k);
-        const double* x = mjtether::NodePositions(m, d, k);
+        const mjtether::Tether* t = mjtether::GetTether(mm, k);
+        const double* x = mjtether::NodePositions(mm, o, k);
+        const std::string name = CsvField(mjtether::TetherName(mm, k));
         T.resize(t->segments());
-        mjtether::GetTensions(m, d, k, T.data());
+        mjtether::GetTensions(mm, o, k, T.data());
+        std::ostringstream rows_k;
+        rows_k.precision(opt.digits);
         for (int i = 0; i < t->nodes(); ++i) {
-          nodes << d->time << "," << mjtether::TetherName(m, k) << "," << i << "," << x[3 * i]
-                << "," << x[3 * i + 1] << "," << x[3 * i + 2] << ","
-                << T[std::min(i, t->segments() - 1)] << "\n";
+          rows_k << o->time << "," << name << "," << i << "," << x[3 * i] << "," << x[3 * i + 1]
+                 << "," << x[3 * i + 2] << "," << T[std::min(i, t->segments() - 1)] << "\n";
         }
+        nodes.Write(rows_k.str());
       }
     }
+    ++rows;
+    last_row_time = o->time;
   };
 
   // Samples at t_k = k * every, scheduled by step index so that no time is accumulated.
@@ -139,60 +161,59 @@ int Run(const RunOptions& opt) {
   const double every = std::max(opt.every, h);
   long long next_sample = 0, sample_index = 0;
   std::optional<mjtether::cli::RunSummary> run_summary;
-  if (!opt.summary.empty()) run_summary.emplace(m);
+  if (!opt.summary.empty()) run_summary.emplace(mm);
   const auto start = std::chrono::steady_clock::now();
-  int status = 0;
+  int status = kExitOk;
   for (long long i = 0;; ++i) {
-    mjtether::Prescribe(m, d);  // motion: and thrust: declarations at d->time
+    mjtether::Prescribe(mm, d);  // motion: and thrust: declarations at d->time
     if (i == next_sample) {
       sample();
       ++sample_index;
       next_sample = std::llround(sample_index * every / h);
+      if (log.failed() || nodes.failed()) break;  // a write failed: reported below (exit 5)
     }
     if (i == steps) break;
-    mj_step(m, d);
-    if (run_summary) run_summary->Observe(m, d);
-    if (std::optional<std::string> diverged = mjtether::CheckDivergence(m, d)) {
-      std::cerr << "mjtether: " << *diverged << "\n";
-      status = 1;
+    if (const int signal = StopSignal()) {
+      std::cerr << "mjtether: " << opt.model << ": " << Interrupted(signal, d->time, i, steps);
+      if (rows > 0)
+        std::cerr << "; the outputs keep " << rows << " sample(s) up to t = " << last_row_time
+                  << " s";
+      std::cerr << "\n";
+      status = 128 + signal;
       break;
     }
-    if (d->warning[mjWARN_BADQACC].number > 0) {
-      std::cerr << "mjtether: " << opt.model << ": MuJoCo found a bad acceleration at t = "
-                << d->time << " s and reset the simulation; reduce <option timestep> (now " << h
-                << " s) or use a stiffer-safe integrator (implicit tether, RK4 for the bodies)\n";
-      status = 1;
+    if (std::optional<std::string> stop = StepAndCheck(mm, d, opt.model)) {
+      std::cerr << "mjtether: " << *stop << "\n";
+      status = kExitDiverged;
       break;
     }
+    if (run_summary) run_summary->Observe(mm, d);
   }
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (status == 0) {
+  for (OutputFile* f : {&log, &nodes}) {
+    if (!f->Commit(&error)) {
+      std::cerr << "mjtether: " << error << "\n";
+      if (status == kExitOk) status = kExitOutput;
+    }
+  }
+  if (status == kExitOk) {
     std::cerr << "mjtether: simulated " << d->time << " s in " << wall << " s wall ("
               << (wall > 0 ? d->time / wall : 0) << "x real time)";
     if (!opt.log.empty()) std::cerr << "; log: " << opt.log;
     std::cerr << "\n";
   }
-  if (run_summary && !run_summary->Write(opt.summary, m, d)) {
-    std::cerr << "mjtether: cannot write --summary " << opt.summary << "\n";
-    status = status ? status : 2;
+  if (run_summary && !run_summary->Write(opt.summary, mm, d)) {
+    std::cerr << "mjtether: output error: cannot write --summary " << opt.summary << "\n";
+    status = status ? status : kExitOutput;
   }
-  mj_deleteData(d);
-  mjtether::Detach(m);
-  mj_deleteModel(m);
   return status;
 }
 
 int Info(const std::string& path) {
-  std::string error;
-  mjModel* m = mjtether::LoadModel(path, &error);
-  if (!m) {
-    std::cerr << "mjtether: " << error << "\n";
-    return 2;
-  }
-  for (const std::string& w : mjtether::Warnings(m)) {
-    std::cerr << "mjtether: warning: " << w << "\n";
-  }
+  mjtether::cli::ModelPtr owner = mjtether::cli::LoadChecked(path);
+  if (!owner) return mjtether::cli::kExitBadInput;
+  const mjModel* m = owner.get();
   std::cout << path << ": timestep " << m->opt.timestep << " s, "
             << mjtether::TetherCount(m) << " tether(s)\n";
   for (int k = 0; k < mjtether::TetherCount(m); ++k) {
@@ -220,8 +241,6 @@ int Info(const std::string& path) {
               << veh->explicit_added_mass().maxCoeff() / (mass + veh->armature_translation())
               << " of m + a_iso; limit " << mjtether::Vehicle::kMaxExplicitRatio << ")\n";
   }
-  mjtether::Detach(m);
-  mj_deleteModel(m);
   return 0;
 }
 
@@ -236,11 +255,14 @@ std::function<int()> SetupRun(CLI::App* sub) {
       ->check(CLI::ExistingFile);
   sub->add_option("--duration", opt->duration, "simulated time [s]")
       ->required()
-      ->check(CLI::Range(0.0, 1e7));
+      ->check(mjtether::cli::Number(0, 1e7, false, "s"));
   sub->add_option("--log", opt->log, "CSV: time, free bodies' positions, end tensions");
   sub->add_option("--nodes", opt->nodes, "CSV: time,tether,node,x,y,z,tension");
   sub->add_option("--every", opt->every, "sampling interval of both CSV files [s]")
-      ->check(CLI::Range(1e-9, 1e7));
+      ->check(mjtether::cli::Number(0, 1e7, true, "s"));
+  sub->add_option("--digits", opt->digits,
+                  "significant digits of the CSV numbers (default 9; 17 is exact)")
+      ->check(CLI::Range(1, 17));
   sub->add_option("--set", opt->set,
                   "override one declaration key, TEXT.KEY=VALUE (e.g. water.current=0.5,0,0); "
                   "repeatable")

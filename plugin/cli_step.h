@@ -14,15 +14,19 @@
 
 namespace mjtether::cli {
 
-// Returns why the run must stop (exit status 1), or nullopt.
+// Returns why the run must stop (exit status 1), or nullopt. MuJoCo resets the data when it
+// finds a bad acceleration (d->time goes back to 0), so the time reported is the step's own.
 inline std::optional<std::string> StepAndCheck(const mjModel* m, mjData* d,
                                                const std::string& model) {
+  const double t0 = d->time;
+  const int bad_before = d->warning[mjWARN_BADQACC].number;
   mjtether::Step(m, d);  // Prescribe (schedules at d->time), then mj_step
   if (std::optional<std::string> diverged = mjtether::CheckDivergence(m, d)) return diverged;
-  if (d->warning[mjWARN_BADQACC].number > 0) {
+  if (d->warning[mjWARN_BADQACC].number > bad_before) {
     std::ostringstream s;
-    s << model << ": MuJoCo found a bad acceleration at t = " << d->time
-      << " s and reset the simulation; reduce <option timestep> (now " << m->opt.timestep
+    s << model << ": MuJoCo found a bad acceleration in the step from t = " << t0 << " s (dof "
+      << d->warning[mjWARN_BADQACC].lastinfo
+      << ") and reset the simulation; reduce <option timestep> (now " << m->opt.timestep
       << " s) or use a stiffer-safe integrator (implicit tether, RK4 for the bodies)";
     return s.str();
   }

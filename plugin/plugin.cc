@@ -15,6 +15,8 @@
 #include "contact_glue.h"
 #include "declaration.h"
 #include "mjtether.h"
+#include "model_files.h"
+#include "text_check.h"
 #include "vehicle_glue.h"
 
 namespace mjtether {
@@ -358,6 +360,27 @@ bool Advise(const Tether& t, double timestep, std::string* warning, std::string*
   return false;
 }
 
+// True when `body` moves with a mocap body: it is one, or is welded (no joint) to one through
+// every body up to it. A body with a joint of its own below a mocap body is dynamic: it
+// receives the tether's force like any other.
+bool MovedByMocap(const mjModel* m, int body) {
+  for (int b = body; b > 0; b = m->body_parentid[b]) {
+    if (m->body_mocapid[b] >= 0) return true;
+    if (m->body_jntnum[b] > 0) return false;
+  }
+  return false;
+}
+
+// The body with a free joint that carries `body` (itself or an ancestor), or -1.
+int FreeCarrier(const mjModel* m, int body) {
+  for (int b = body; b > 0; b = m->body_parentid[b]) {
+    for (int j = m->body_jntadr[b]; j >= 0 && j < m->body_jntadr[b] + m->body_jntnum[b]; ++j) {
+      if (m->jnt_type[j] == mjJNT_FREE) return b;
+    }
+  }
+  return -1;
+}
+
 }  // namespace
 
 void InstallErrorHandlers() {
@@ -374,6 +397,13 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
   {
     std::shared_lock<std::shared_mutex> lock(g_mutex);
     if (g_models.count(m)) return fail("", "this model is already attached");
+  }
+  // A text named like one of our declarations but not quite ("Tether:x", "tether_x", "Water")
+  // would otherwise be ignored silently.
+  for (int i = 0; i < m->ntext; ++i) {
+    if (std::optional<std::string> near = NearMissDeclaration(TextName(m, i))) {
+      return fail(TextName(m, i), *near);
+    }
   }
   // The environment: gravity from <option>, water from <text name="water">.
   Environment env;
@@ -422,7 +452,21 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
         return fail(name, "key 'ends': no site named '" + sites[end] + "' in the model");
       }
       at.body[end] = m->site_bodyid[at.site[end]];
-      at.mocap[end] = m->body_mocapid[m->body_rootid[at.body[end]]] >= 0;
+      at.mocap[end] = MovedByMocap(m, at.body[end]);
+      // A free body at a tether end in water gets buoyancy, drag and current only from a
+      // vehicle: declaration; without one it is dry apart from the tether.
+      const int carrier = FreeCarrier(m, at.body[end]);
+      const char* carrier_name = carrier > 0 ? mj_id2name(m, mjOBJ_BODY, carrier) : nullptr;
+      if (env.wet && carrier > 0 &&
+          (!carrier_name ||
+           mj_name2id(m, mjOBJ_TEXT, (std::string("vehicle:") + carrier_name).c_str()) < 0)) {
+        const std::string body = carrier_name ? carrier_name : "body " + std::to_string(carrier);
+        set->warnings.push_back(source + ": <text name=\"" + name + "\">: end " + "AB"[end] +
+                                " is on free body '" + body +
+                                "' in water, which has no <text name=\"vehicle:" + body +
+                                "\">: it gets no buoyancy, drag, added mass or current; "
+                                "declare the vehicle (README, Vehicles)");
+      }
     }
     if (at.contact) {
       std::vector<std::string> notes;
@@ -479,6 +523,7 @@ mjModel* LoadModel(const std::string& path, std::string* error) {
     return nullptr;
   }
   if (!Attach(m, path, error)) {
+    if (error) *error = NameIncludedFile(path, *error);  // the element may be in an <include>
     mj_deleteModel(m);
     return nullptr;
   }

@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "text_check.h"
+
 namespace mjtether {
 namespace {
 
@@ -19,21 +21,14 @@ bool Fail(DeclarationError* error, const std::string& key, const std::string& me
   return false;
 }
 
-// Parses a finite number that fills the whole string (no "1.5abc", no "nan", no "inf").
+// Parses a finite decimal number that fills the whole string (no "1.5abc", "nan", "inf" or
+// "0x10"; see ParseDecimal).
 bool ParseNumber(const std::string& key, const std::string& text, double* value,
                  DeclarationError* error) {
-  const char* begin = text.c_str();
-  char* end = nullptr;
-  errno = 0;
-  double x = std::strtod(begin, &end);
-  if (end == begin || *end != '\0') {
-    return Fail(error, key, "key '" + key + "': '" + text + "' is not a number");
-  }
-  if (!std::isfinite(x) || errno == ERANGE) {
-    return Fail(error, key, "key '" + key + "': '" + text + "' is not a finite number");
-  }
-  *value = x;
-  return true;
+  const NumberStatus status = ParseDecimal(text, value);
+  if (status == NumberStatus::kOk) return true;
+  return Fail(error, key,
+              "key '" + Shown(key) + "': '" + Shown(text) + "' " + NumberProblem(status));
 }
 
 // A closed or half-open range [lo, hi] or (lo, hi]; NaN fails every comparison, so the checks
@@ -50,10 +45,18 @@ struct Range {
 bool ParseInRange(const std::string& key, const std::string& text, const Range& range,
                   double* value, DeclarationError* error) {
   double x;
+  if (ParseDecimal(text, &x) == NumberStatus::kUnderflow) {
+    return Fail(error, key,
+                "key '" + key + "' = " + Shown(text) +
+                    " is out of range (below 2.2e-308 in magnitude; write 0 or a larger number); "
+                    "allowed: " +
+                    range.Describe());
+  }
   if (!ParseNumber(key, text, &x, error)) return false;
   if (!range.Contains(x)) {
-    return Fail(error, key,
-                "key '" + key + "' = " + text + " is out of range; allowed: " + range.Describe());
+    return Fail(
+        error, key,
+        "key '" + key + "' = " + Shown(text) + " is out of range; allowed: " + range.Describe());
   }
   *value = x;
   return true;
@@ -64,8 +67,9 @@ bool ParseInteger(const std::string& key, const std::string& text, const Range& 
   double x;
   if (!ParseInRange(key, text, range, &x, error)) return false;
   if (x != std::floor(x)) {
-    return Fail(error, key, "key '" + key + "' = " + text + " must be a whole number in " +
-                                range.Describe());
+    return Fail(
+        error, key,
+        "key '" + key + "' = " + Shown(text) + " must be a whole number in " + range.Describe());
   }
   *value = static_cast<int>(x);
   return true;
@@ -84,45 +88,55 @@ bool ParseVector(const std::string& key, const std::string& text, Vec3* v,
                  DeclarationError* error) {
   std::vector<std::string> items = SplitList(text);
   if (items.size() != 3) {
-    return Fail(error, key, "key '" + key + "' = " + text + " must be 3 numbers x,y,z");
+    return Fail(error, key, "key '" + key + "' = " + Shown(text) + " must be 3 numbers x,y,z");
   }
   for (int i = 0; i < 3; ++i) {
     if (!ParseNumber(key, items[i], &(*v)[i], error)) return false;
     if (!(std::abs((*v)[i]) <= 1e3)) {
-      return Fail(error, key, "key '" + key + "' = " + text + ": each component in [-1000, 1000]");
+      return Fail(error, key,
+                  "key '" + key + "' = " + Shown(text) + ": each component in [-1000, 1000]");
     }
   }
   return true;
 }
 
+// "unknown key 'diamter'; did you mean 'diameter'? (allowed keys: ...)".
 std::string UnknownKey(const std::string& key, const char* const* allowed, int n) {
   std::string list;
-  for (int i = 0; i < n; ++i) list += std::string(i ? ", " : "") + allowed[i];
-  return "unknown key '" + key + "'; allowed keys: " + list;
+  std::vector<std::string> keys;
+  for (int i = 0; i < n; ++i) {
+    list += std::string(i ? ", " : "") + allowed[i];
+    keys.emplace_back(allowed[i]);
+  }
+  return "unknown key '" + Shown(key) + "'" + DidYouMean(key, keys) + "; allowed keys: " + list;
 }
 
 }  // namespace
 
 std::optional<KeyValues> SplitKeyValues(const std::string& text, DeclarationError* error) {
   KeyValues pairs;
+  if (std::optional<std::string> odd = OddCharacter(text)) {
+    Fail(error, "", *odd);
+    return std::nullopt;
+  }
   std::istringstream s(text);
   std::string token;
   while (s >> token) {
     size_t eq = token.find('=');
     if (eq == std::string::npos) {
-      Fail(error, "", "'" + token + "' is not of the form key=value");
+      Fail(error, "", "'" + Shown(token) + "' is not of the form key=value");
       return std::nullopt;
     }
     std::string key = token.substr(0, eq), value = token.substr(eq + 1);
     if (key.empty() || value.empty()) {
       Fail(error, key,
-           (key.empty() ? "" : "key '" + key + "': ") + "'" + token +
+           (key.empty() ? "" : "key '" + Shown(key) + "': ") + "'" + Shown(token) +
                "' needs both a key and a value (key=value, no spaces)");
       return std::nullopt;
     }
     for (const auto& kv : pairs) {
       if (kv.first == key) {
-        Fail(error, key, "key '" + key + "' is given twice");
+        Fail(error, key, "key '" + Shown(key) + "' is given twice");
         return std::nullopt;
       }
     }
@@ -217,12 +231,14 @@ std::optional<unsigned> ResolveEffects(const TetherParams& p, const Environment&
       if (name == kEffectNames[i]) found = i;
     }
     if (found < 0) {
-      Fail(error, "effects", "key 'effects': unknown effect '" + name + "'; allowed: " +
-                                 EffectsToString((1u << kNumEffects) - 1));
+      Fail(error, "effects",
+           "key 'effects': unknown effect '" + Shown(name) +
+               "'; allowed: " + EffectsToString((1u << kNumEffects) - 1));
       return std::nullopt;
     }
     if (!needs[found].available) {
-      Fail(error, "effects", "key 'effects': effect '" + name + "' needs " + needs[found].missing);
+      Fail(error, "effects",
+           "key 'effects': effect '" + Shown(name) + "' needs " + needs[found].missing);
       return std::nullopt;
     }
     effects |= 1u << found;
@@ -262,21 +278,15 @@ std::optional<TetherDeclaration> ParseTether(const std::string& text, const Envi
   TetherDeclaration decl;
   TetherParams& p = decl.params;
   std::string clamp;
-  for (const char* key : kRequired) {
-    bool present = false;
-    for (const auto& kv : *pairs) present |= kv.first == key;
-    if (!present) {
-      Fail(error, key, std::string("missing required key '") + key + "'");
-      return std::nullopt;
-    }
-  }
   for (const auto& [key, value] : *pairs) {
     bool ok = true;
     if (key == "ends") {
       std::vector<std::string> sites = SplitList(value);
       if (sites.size() != 2 || sites[0].empty() || sites[1].empty()) {
-        ok = Fail(error, key, "key 'ends' = " + value + " must be two site names A,B (B may be "
-                              "'free')");
+        ok = Fail(error, key,
+                  "key 'ends' = " + Shown(value) +
+                      " must be two site names A,B (B may be "
+                      "'free')");
       } else if (sites[0] == "free") {
         ok = Fail(error, key, "key 'ends': end A must be a site; only end B may be 'free'");
       } else if (sites[0] == sites[1]) {
@@ -318,8 +328,9 @@ std::optional<TetherDeclaration> ParseTether(const std::string& text, const Envi
       } else if (value == "rk4") {
         p.integrator = Integrator::kRK4;
       } else {
-        ok = Fail(error, key,
-                  "key 'integrator' = " + value + "; allowed: explicit, implicit, implicit2, rk4");
+        ok = Fail(
+            error, key,
+            "key 'integrator' = " + Shown(value) + "; allowed: explicit, implicit, implicit2, rk4");
       }
     } else if (key == "bending") {
       if (value == "galerkin") {
@@ -327,14 +338,14 @@ std::optional<TetherDeclaration> ParseTether(const std::string& text, const Envi
       } else if (value == "der") {
         p.bending = Bending::kDER;
       } else {
-        ok = Fail(error, key, "key 'bending' = " + value + "; allowed: galerkin, der");
+        ok = Fail(error, key, "key 'bending' = " + Shown(value) + "; allowed: galerkin, der");
       }
     } else if (key == "clamp") {
       clamp = value;
       p.clamp_a = value == "A" || value == "both";
       p.clamp_b = value == "B" || value == "both";
       if (!p.clamp_a && !p.clamp_b) {
-        ok = Fail(error, key, "key 'clamp' = " + value + "; allowed: A, B, both");
+        ok = Fail(error, key, "key 'clamp' = " + Shown(value) + "; allowed: A, B, both");
       }
     } else if (key == "effects") {
       decl.effects_text = value;
@@ -362,6 +373,15 @@ std::optional<TetherDeclaration> ParseTether(const std::string& text, const Envi
       ok = Fail(error, key, UnknownKey(key, kKeys, std::size(kKeys)));
     }
     if (!ok) return std::nullopt;
+  }
+  // Required keys after the unknown ones, so that 'diamter=' reads as a misspelling.
+  for (const char* key : kRequired) {
+    bool present = false;
+    for (const auto& kv : *pairs) present |= kv.first == key;
+    if (!present) {
+      Fail(error, key, std::string("missing required key '") + key + "'");
+      return std::nullopt;
+    }
   }
   if (p.free_end && p.clamp_b) {
     Fail(error, "clamp", "key 'clamp' = " + clamp + ": end B is free and cannot be clamped");

@@ -6,26 +6,33 @@
 #include <fstream>
 #include <sstream>
 
+#include "text_check.h"
+
 namespace mjtether {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// Parses "a,b,c,d" into 4 finite numbers; false otherwise.
+// Parses "a,b,c,d" into 4 decimal numbers (surrounding blanks allowed); false otherwise.
 bool ParseRow(const std::string& line, double out[4]) {
   std::istringstream s(line);
   std::string item;
   int n = 0;
   while (std::getline(s, item, ',')) {
     if (n == 4) return false;
-    char* end = nullptr;
-    out[n] = std::strtod(item.c_str(), &end);
-    while (end && (*end == ' ' || *end == '\r' || *end == '\t')) ++end;
-    if (end == item.c_str() || *end != '\0' || !std::isfinite(out[n])) return false;
+    const size_t first = item.find_first_not_of(" \t\r"), last = item.find_last_not_of(" \t\r");
+    if (first == std::string::npos) return false;
+    if (ParseDecimal(item.substr(first, last - first + 1), &out[n]) != NumberStatus::kOk) {
+      return false;
+    }
     ++n;
   }
   return n == 4;
 }
+
+// Ranges of a table row: times [s] and offsets [m] (as a harmonic motion's amplitude).
+constexpr double kMaxTableTime = 1e7;
+constexpr double kMaxTableOffset = 1e4;
 
 }  // namespace
 
@@ -49,7 +56,21 @@ std::optional<Motion> Motion::Create(const MotionParams& params, const std::stri
       if (!ParseRow(line, v)) {
         if (row == 1) continue;  // a header
         return fail("key 'csv': " + csv_path + " line " + std::to_string(row) +
-                    ": expected 4 numbers time,x,y,z");
+                    ": expected 4 decimal numbers time,x,y,z");
+      }
+      if (!(std::abs(v[0]) <= kMaxTableTime)) {
+        std::ostringstream o;
+        o << "key 'csv': " << csv_path << " line " << row << ": time " << v[0]
+          << " s outside [-1e7, 1e7]";
+        return fail(o.str());
+      }
+      for (int i = 1; i < 4; ++i) {
+        if (!(std::abs(v[i]) <= kMaxTableOffset)) {
+          std::ostringstream o;
+          o << "key 'csv': " << csv_path << " line " << row << ": offset "
+            << "xyz"[i - 1] << " = " << v[i] << " m outside [-10000, 10000]";
+          return fail(o.str());
+        }
       }
       if (!mo.time_.empty() && !(v[0] > mo.time_.back())) {
         return fail("key 'csv': " + csv_path + " line " + std::to_string(row) +

@@ -6,6 +6,8 @@
 #include <sstream>
 #include <vector>
 
+#include "text_check.h"
+
 namespace mjtether {
 namespace {
 
@@ -31,29 +33,41 @@ bool ParseList(const std::string& key, const std::string& text, int count, doubl
   while (std::getline(s, item, ',')) items.push_back(item);
   if (!text.empty() && text.back() == ',') items.push_back("");
   if ((count > 0 && static_cast<int>(items.size()) != count) || items.empty()) {
-    return Fail(error, key, "key '" + key + "' = " + text + " must be " + what);
+    return Fail(error, key, "key '" + key + "' = " + Shown(text) + " must be " + what);
   }
   out->clear();
   for (const std::string& it : items) {
-    char* end = nullptr;
-    errno = 0;
-    const double x = std::strtod(it.c_str(), &end);
-    if (end == it.c_str() || *end != '\0' || !std::isfinite(x) || errno == ERANGE) {
-      return Fail(error, key, "key '" + key + "': '" + it + "' is not a finite number");
+    double x = 0;
+    const NumberStatus status = ParseDecimal(it, &x);
+    if (status == NumberStatus::kUnderflow) {
+      return Fail(error, key,
+                  "key '" + key + "' = " + Shown(text) +
+                      ": a value is out of range (below 2.2e-308 in magnitude; write 0 or a "
+                      "larger number); each value in " +
+                      range);
+    }
+    if (status != NumberStatus::kOk) {
+      return Fail(error, key, "key '" + key + "': '" + Shown(it) + "' " + NumberProblem(status));
     }
     if (!((lo_open ? x > lo : x >= lo) && x <= hi)) {
-      return Fail(error, key,
-                  "key '" + key + "' = " + text + ": each value in " + range + " (" + what + ")");
+      return Fail(
+          error, key,
+          "key '" + key + "' = " + Shown(text) + ": each value in " + range + " (" + what + ")");
     }
     out->push_back(x);
   }
   return true;
 }
 
+// "unknown key 'volme'; did you mean 'volume'? (allowed keys: ...)".
 std::string UnknownKey(const std::string& key, const std::vector<const char*>& allowed) {
   std::string list;
-  for (size_t i = 0; i < allowed.size(); ++i) list += std::string(i ? ", " : "") + allowed[i];
-  return "unknown key '" + key + "'; allowed keys: " + list;
+  std::vector<std::string> keys;
+  for (size_t i = 0; i < allowed.size(); ++i) {
+    list += std::string(i ? ", " : "") + allowed[i];
+    keys.emplace_back(allowed[i]);
+  }
+  return "unknown key '" + Shown(key) + "'" + DidYouMean(key, keys) + "; allowed keys: " + list;
 }
 
 }  // namespace
@@ -83,7 +97,7 @@ std::optional<VehicleParams> ParseVehicle(const std::string& text, DeclarationEr
     } else if (key == "coriolis") {
       p.coriolis = value == "1";
       if (value != "0" && value != "1") {
-        ok = Fail(error, key, "key 'coriolis' = " + value + "; allowed: 0, 1");
+        ok = Fail(error, key, "key 'coriolis' = " + Shown(value) + "; allowed: 0, 1");
       }
     } else {
       ok = Fail(error, key, UnknownKey(key, kKeys));
@@ -155,7 +169,7 @@ std::optional<Schedule> ParseSchedule(const std::string& text, DeclarationError*
       for (size_t i = 1; ok && i < s.t.size(); ++i) {
         if (s.t[i] < s.t[i - 1])
           ok = Fail(error, key,
-                    "key 't' = " + value +
+                    "key 't' = " + Shown(value) +
                         ": times must not "
                         "decrease");
       }

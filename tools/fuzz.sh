@@ -11,7 +11,7 @@ out=build-fuzz
 mkdir -p "$out/corpus" "$out/artifacts"
 clang++-14 -std=c++17 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
   -fno-omit-frame-pointer -Isrc -isystem /usr/include/eigen3 \
-  src/declaration.cc src/tether.cc tests/fuzz/declaration_fuzz.cc -o "$out/declaration_fuzz"
+  src/declaration.cc src/text_check.cc src/tether.cc tests/fuzz/declaration_fuzz.cc -o "$out/declaration_fuzz"
 # Seeds: the data="..." of every <text> in the models, and edge cases.
 i=0
 for f in models/*.xml; do

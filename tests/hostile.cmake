@@ -1,0 +1,18 @@
+# Issue 14: the hostile-input suite (tests/hostile/cases.txt through the real binary), and
+# observation without side effects plus the mocap-subtree rule (tests/observe_test.cc).
+add_executable(hostile_test hostile_test.cc)
+target_link_libraries(hostile_test PRIVATE mjtether_core GTest::gtest_main)
+target_compile_definitions(hostile_test PRIVATE
+  MJTETHER_HOSTILE_DIR="${CMAKE_CURRENT_SOURCE_DIR}/hostile"
+  MJTETHER_CLI="$<TARGET_FILE:mjtether>")
+add_dependencies(hostile_test mjtether)
+gtest_discover_tests(hostile_test DISCOVERY_TIMEOUT 60 PROPERTIES LABELS hostile)
+
+add_executable(observe_test observe_test.cc)
+target_link_libraries(observe_test PRIVATE mjtether_plugin GTest::gtest_main)
+target_include_directories(observe_test PRIVATE ${CLI11_INCLUDE_DIR})
+target_compile_definitions(observe_test PRIVATE
+  MJTETHER_HOSTILE_DIR="${CMAKE_CURRENT_SOURCE_DIR}/hostile"
+  MJTETHER_CLI="$<TARGET_FILE:mjtether>")
+add_dependencies(observe_test mjtether)
+gtest_discover_tests(observe_test DISCOVERY_TIMEOUT 60)
