@@ -203,7 +203,8 @@ int Run(const RunOptions& opt) {
     if (!opt.log.empty()) std::cerr << "; log: " << opt.log;
     std::cerr << "\n";
   }
-  if (run_summary && !run_summary->Write(opt.summary, mm, d)) {
+  // The summary observes the final state as the last log row does (brought to d->time on a copy).
+  if (run_summary && !run_summary->Write(opt.summary, mm, observer.Observe(d))) {
     std::cerr << "mjtether: output error: cannot write --summary " << opt.summary << "\n";
     status = status ? status : kExitOutput;
   }
