@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
+#include <unistd.h>
 
 #include "catenary_reference.h"
 #include "mujoco_fixture.h"
@@ -341,7 +342,9 @@ TEST_F(MuJoCoTest, OutOfRangeValueIsReported) {
 // The command line: a bad file exits with code 2 and names file, tether and key; a good
 // one writes the documented columns at the requested rate.
 int RunCli(const std::string& args, std::string* output) {
-  const std::string out = ::testing::TempDir() + "/cli_output.txt";
+  // One file per process: ctest -j runs the Cli tests in parallel processes.
+  const std::string out =
+      ::testing::TempDir() + "/cli_output_" + std::to_string(getpid()) + ".txt";
   const int status = std::system((std::string(MJTETHER_CLI) + " " + args + " > " + out +
                                   " 2>&1 < /dev/null").c_str());
   std::ifstream f(out);
