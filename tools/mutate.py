@@ -95,18 +95,24 @@ def run(cmd, cwd=None, log=None, timeout=None):
 
 def sync_tree(scratch):
   """Copies the repository's tracked and unignored files into scratch/tree. Files whose content
-  is unchanged keep their time stamps (no rebuild); changed ones get the current time (rsync
-  without -t), so that ninja rebuilds them even when the repository's copy is older."""
+  is unchanged keep their time stamps (no rebuild); changed ones are written anew and get the
+  current time, so that ninja rebuilds them even when the repository's copy is older."""
   tree = scratch / "tree"
   tree.mkdir(parents=True, exist_ok=True)
   files = subprocess.run(["git", "ls-files", "-co", "--exclude-standard", "-z"], cwd=REPO,
                          check=True, stdout=subprocess.PIPE).stdout
-  listing = scratch / "files.txt"
-  listing.write_bytes(files)
-  subprocess.run(["rsync", "-rl", "--checksum", "--from0", f"--files-from={listing}",
-                  f"{REPO}/", f"{tree}/"], check=True)
-  # Remove scratch files the repository no longer has (a renamed source would still be globbed).
   keep = {f.decode() for f in files.split(b"\0") if f}
+  for name in sorted(keep):
+    src, dst = REPO / name, tree / name
+    if not src.is_file():
+      continue  # deleted in the working tree but not yet in the index
+    data = src.read_bytes()
+    if dst.is_file() and dst.read_bytes() == data:
+      continue
+    dst.parent.mkdir(parents=True, exist_ok=True)
+    dst.write_bytes(data)
+    shutil.copymode(src, dst)
+  # Remove scratch files the repository no longer has (a renamed source would still be globbed).
   for root in ("src", "plugin", "tests", "examples", "models", "tools"):
     base = tree / root
     if not base.exists():
@@ -187,7 +193,8 @@ def main():
     if unknown:
       print(f"unknown entries: {', '.join(unknown)}", file=sys.stderr)
       return 2
-    entries = [e for e in entries if e["id"] in wanted]
+    by_id = {e["id"]: e for e in entries}
+    entries = [by_id[w] for w in wanted]  # in the order given
   if args.sample:
     entries = [e for e in entries if e["sample"]]
 
