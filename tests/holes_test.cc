@@ -2,6 +2,7 @@
 // found: each checks one force term, end reaction or output against an independent reference
 // (a closed form, a statics balance written out here from the declaration, or a boundary of a
 // documented range), so that the planted bug named in its comment fails it.
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -22,6 +23,7 @@
 #include "mjtether_vehicles.h"
 #include "mujoco_fixture.h"
 #include "tether.h"
+#include "vehicle_declaration.h"
 
 namespace mjtether {
 namespace {
@@ -107,6 +109,33 @@ TEST_P(TowedAlongItsAxis, TowForceIsTheClosedFormTangentialDrag) {
   EXPECT_NEAR(r.force_a.x(), -F, 1e-3 * F);  // drag pulls end A back
 }
 
+// The same tow with backward Euler at a step 250 times longer (0.5 s): the steady tow is a
+// fixed point of the scheme, so the force is the same closed form. The step is 5 times the
+// explicit limit of the tangential drag (2 / (2 kt U l_i / m_i) = 0.19 s): only the drag's
+// Jacobian in the Newton solve keeps it stable. Catches a Jacobian without its tangential
+// block.
+TEST(Holes, TowedAlongItsAxisAtALongImplicitStep) {
+  TetherParams p;
+  p.length = 10;
+  p.segments = 20;
+  p.diameter = 0.02;
+  p.mass_per_length = 0.3;
+  p.EA = 1e6;
+  p.damping = 200;
+  p.Cdn = 1.2;
+  p.Cdt = 0.05;
+  p.free_end = true;
+  const Environment env = Water(false);
+  Tow s(Make(p, env, "axial,damping,drag"));
+  const double U = 1;
+  s.ends.a.axis = Vec3(-1, 0, 0);
+  s.tether.InitialShape(s.ends, s.x.data(), s.v.data());
+  s.SetVelocity(Vec3(U, 0, 0));
+  ASSERT_TRUE(s.Run(0.5, 40));
+  const double F = 0.5 * env.water.density * p.Cdt * kPi * p.diameter * U * U * p.length;
+  EXPECT_NEAR(s.Reactions().tension_a / F, 1, 1e-3);
+}
+
 INSTANTIATE_TEST_SUITE_P(Holes, TowedAlongItsAxis,
                          ::testing::Values(Integrator::kImplicit, Integrator::kExplicit),
                          [](const ::testing::TestParamInfo<Integrator>& i) {
@@ -165,6 +194,52 @@ TEST(Holes, SeabedFrictionAlongAndAcrossFollowTheirOwnCoefficients) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Net weight: a wet chain hanging still from a fixed end (end B free) hangs its whole net
+// weight on the end, (m' - rho pi d^2/4) g L (Archimedes over the displaced volume of the
+// whole length), here (1 - 0.322) 9.81 10 = 66.5 N. Static: the 1e-4 covers what is left of
+// the settling (the stretch, 7e-5, moves no weight). Catches buoyancy or weight lumped wrongly
+// at the end nodes or off by a constant.
+TEST(Holes, WetChainHangsItsNetWeightOnItsEnd) {
+  TetherParams p;
+  p.length = 10;
+  p.segments = 10;
+  p.diameter = 0.02;
+  p.mass_per_length = 1;
+  p.EA = 1e6;
+  p.damping = 1e3;
+  p.free_end = true;
+  const Environment env = Water(true);
+  Tow s(Make(p, env, "axial,damping,weight,buoyancy"));
+  s.tether.InitialShape(s.ends, s.x.data(), s.v.data());
+  ASSERT_TRUE(s.Run(0.005, 1000));
+  const double area = kPi * p.diameter * p.diameter / 4;
+  const double W = (p.mass_per_length - env.water.density * area) * kG * p.length;
+  const EndReactions r = s.Reactions();
+  EXPECT_NEAR(r.tension_a, W, 1e-4 * W);
+  EXPECT_NEAR(r.force_a.z(), -W, 1e-4 * W);  // the chain pulls its end down
+}
+
+// The reported segment tension is the whole axial law, elastic and damping (Kelvin-Voigt,
+// Buckham et al. 2003): one segment of rest length 1 m stretched by 1% and lengthening at
+// 0.5 m/s carries EA 0.01 + (damping / L0) 0.5 = 100 + 50 N; shortened, it carries none.
+TEST(Holes, ReportedTensionIsTheKelvinVoigtLaw) {
+  TetherParams p;
+  p.length = 1;
+  p.segments = 1;
+  p.diameter = 0.02;
+  p.mass_per_length = 1;
+  p.EA = 1e4;
+  p.damping = 100;
+  const Tether t = Make(p, Environment(), "axial,damping");
+  std::vector<double> x = {0, 0, 0, 1.01, 0, 0}, v = {0, 0, 0, 0.5, 0, 0}, T(1);
+  t.Tensions(x.data(), v.data(), T.data());
+  EXPECT_NEAR(T[0], 150, 1e-9);
+  x[3] = 0.99;
+  t.Tensions(x.data(), v.data(), T.data());
+  EXPECT_EQ(T[0], 0);
+}
+
+// ---------------------------------------------------------------------------------------------
 // The declaration parser's ranges, at their boundaries: the documented maximum is accepted and
 // the next number above it refused; a bound written "(0, ..." refuses 0 itself. Catches
 // ranges enforced more loosely than their messages say.
@@ -208,6 +283,38 @@ TEST(Holes, DeclaredRangesHoldAtTheirBoundaries) {
   EXPECT_FALSE(ParseWater("density=0", &e).has_value());
   EXPECT_TRUE(ParseWater("density=1e4", &e).has_value());
   EXPECT_FALSE(ParseWater("density=1.01e4", &e).has_value());
+  // A vehicle's volume in [0, 1e4] m^3: a negative one would be a buoyancy that pulls down.
+  EXPECT_TRUE(ParseVehicle("volume=0.05", &e).has_value());
+  EXPECT_FALSE(ParseVehicle("volume=-0.05", &e).has_value());
+  EXPECT_FALSE(ParseVehicle("volume=1.1e4", &e).has_value());
+}
+
+// A MuJoCo error during the run (here its stack overflows once eight boxes land on the floor
+// and make contacts: <size nstack> fixes it too small for them, enough for the model at rest)
+// exits with code 3 and MuJoCo's message, as the README's exit codes say.
+TEST(Holes, MuJoCoErrorDuringARunExitsWith3) {
+  const std::string tag = std::to_string(getpid());
+  const std::string model = ::testing::TempDir() + "/mujoco_error_" + tag + ".xml";
+  const std::string out = ::testing::TempDir() + "/mujoco_error_" + tag + ".txt";
+  {
+    std::ofstream f(model);
+    f << R"(<mujoco><size nstack="1000"/><worldbody><geom type="plane" size="5 5 0.1"/>)";
+    for (int i = 0; i < 8; ++i) {
+      f << "<body pos=\"" << 0.25 * i << R"( 0 0.3"><freejoint/>)"
+        << R"(<geom type="box" size="0.1 0.1 0.1"/></body>)";
+    }
+    f << "</worldbody></mujoco>";
+  }
+  const int status = std::system((std::string(MJTETHER_CLI) + " run " + model +
+                                  " --duration 1 > " + out + " 2>&1 < /dev/null").c_str());
+  std::ifstream f(out);
+  std::stringstream text;
+  text << f.rdbuf();
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 3) << text.str();
+  EXPECT_NE(text.str().find("MuJoCo error"), std::string::npos) << text.str();
+  std::remove(model.c_str());
+  std::remove(out.c_str());
 }
 
 // ---------------------------------------------------------------------------------------------
