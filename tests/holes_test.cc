@@ -393,6 +393,43 @@ TEST(Holes, RovStaticPitchInACurrentBalancesForcesAndMomentsAboutTheCentreOfGrav
 }
 
 // ---------------------------------------------------------------------------------------------
+// The clamp moment at end A, on a body. ValidationMuJoCo.EndMomentGivesCircularArc clamps end A
+// to the world and end B to a body; here the same beam is declared the other way round (end A
+// on the body, end B on the world), so that the body receives end A's moment. Its two sites'
+// x-axes point along the tether from A to B (-x). Under a pure end moment M the beam is a
+// circular arc and the body turns by M L/EI (Euler); the lumped model's rotation is exact to
+// theta^2/6 relative at 20 segments (0.1%), tolerance 0.5% as there. Catches end A's moment
+// applied with the wrong sign or not at all.
+TEST(Holes, EndMomentOnABodyAtEndAGivesTheCircularArc) {
+  const double L = 1, EI = 1, M = kPi / 2 * EI / L;
+  testing::LoadedScene s(R"(<mujoco><option timestep="0.0004" gravity="0 0 0"/><custom>
+      <text name="tether:beam" data="ends=tip,root length=1 segments=20 diameter=0.01
+            mass_per_length=0.1 EA=1e4 EI=1 clamp=both"/></custom>
+    <worldbody><site name="root" pos="0 0 0" quat="0 0 0 1"/>
+      <body name="end" pos="1 0 0">
+        <joint type="slide" axis="1 0 0" damping="1"/><joint type="slide" axis="0 0 1" damping="1"/>
+        <joint name="turn" type="hinge" axis="0 1 0" damping="0.5"/>
+        <inertial pos="0 0 0" mass="0.5" diaginertia="1e-2 1e-2 1e-2"/>
+        <site name="tip" quat="0 0 0 1"/>
+      </body></worldbody></mujoco>)");
+  ASSERT_NE(s.m, nullptr);
+  const int body = mj_name2id(s.m, mjOBJ_BODY, "end");
+  const int turn = s.m->jnt_qposadr[mj_name2id(s.m, mjOBJ_JOINT, "turn")];
+  bool settled = false;
+  for (int k = 0; k < 50000 && !settled; ++k) {
+    s.d->xfrc_applied[6 * body + 4] = M * std::min(1.0, s.d->time / 1.0);
+    ASSERT_TRUE(s.Step());
+    double q = 0;
+    for (int i = 0; i < s.m->nv; ++i) q = std::max(q, std::abs(s.d->qvel[i]));
+    settled = s.d->time > 1.5 && q < 1e-7;
+  }
+  EXPECT_TRUE(settled) << "still moving at t = " << s.d->time;
+  std::printf("end A on the body: rotation %.5f rad, M L/EI %.5f rad\n", s.d->qpos[turn],
+              M * L / EI);
+  EXPECT_NEAR(s.d->qpos[turn] / (M * L / EI), 1, 0.005);
+}
+
+// ---------------------------------------------------------------------------------------------
 // The log's columns, each against what it must hold in a scene whose statics are known:
 // - a dry chain (10 m, 1 kg/m, EA 1e7 N) hanging from a fixed site with its end B free: the
 //   site carries the whole weight, tension_A = m g L = 98.1 N; tension_B (free end: the last
