@@ -240,6 +240,46 @@ TEST(Holes, ReportedTensionIsTheKelvinVoigtLaw) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// The seabed under a line lying flat on it: each node is a mass on the seabed's spring and
+// damper, mu l0 z'' = -k l0 (z - z_eq) - c l0 z', at rest at z_eq = -w/k (w the wet weight per
+// length), with the default damping critical, c = 2 sqrt(k mu) (no added mass or drag here).
+// Pressed to twice that depth and released from rest, a critically damped node returns as
+// (1 + w0 t) e^(-w0 t), w0 = sqrt(k/mu) = 316 rad/s, without overshoot: it never rises above
+// z_eq (1% of the penetration allows for the time discretisation at w0 h = 0.03) and is back
+// at z_eq within 1% after 0.1 s (30 / w0). Catches the seabed stiffness or the default
+// damping off.
+TEST(Holes, SeabedUnderALineIsStiffAndCriticallyDamped) {
+  TetherParams p;
+  p.length = 10;
+  p.segments = 10;
+  p.diameter = 0.02;
+  p.mass_per_length = 1;
+  p.EA = 1e5;
+  p.integrator = Integrator::kImplicit;
+  Environment env = Water(true);
+  env.water.has_seabed = true;
+  env.water.seabed = 0;
+  const double area = kPi * p.diameter * p.diameter / 4;
+  const double w = (p.mass_per_length - env.water.density * area) * kG;  // [N/m]
+  const double z_eq = -w / env.water.seabed_stiffness;
+  Tow s(Make(p, env, "axial,weight,buoyancy,seabed"));
+  s.ends.a.pos = Vec3(0, 0, z_eq);
+  s.ends.b.pos = Vec3(p.length, 0, z_eq);
+  s.tether.InitialShape(s.ends, s.x.data(), s.v.data());
+  for (int i = 1; i < p.segments; ++i) s.x[3 * i + 2] = 2 * z_eq;
+  double highest = -INFINITY;
+  for (int k = 0; k < 1000; ++k) {
+    ASSERT_TRUE(s.Run(1e-4, 1));
+    for (int i = 1; i < p.segments; ++i) highest = std::max(highest, s.x[3 * i + 2]);
+  }
+  const int mid = p.segments / 2;
+  std::printf("seabed: highest %.4g of z_eq %.4g m, at 0.1 s %.6g\n", highest, z_eq,
+              s.x[3 * mid + 2]);
+  EXPECT_LT(highest, z_eq - 0.01 * z_eq);  // z_eq < 0: no higher than 1% above it
+  EXPECT_NEAR(s.x[3 * mid + 2], z_eq, -0.01 * z_eq);
+}
+
+// ---------------------------------------------------------------------------------------------
 // The declaration parser's ranges, at their boundaries: the documented maximum is accepted and
 // the next number above it refused; a bound written "(0, ..." refuses 0 itself. Catches
 // ranges enforced more loosely than their messages say.
