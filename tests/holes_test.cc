@@ -2,6 +2,8 @@
 // found: each checks one force term, end reaction or output against an independent reference
 // (a closed form, a statics balance written out here from the declaration, or a boundary of a
 // documented range), so that the planted bug named in its comment fails it.
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -13,9 +15,6 @@
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <mujoco/mujoco.h>
 
 #include "declaration.h"
 #include "make_tether.h"
@@ -79,7 +78,8 @@ Environment Water(bool gravity) {
 //   F = 1/2 rho Cdt pi d U^2 L.
 // The model integrates it over the stretched length, longer by the strain F/EA = 2e-5; after
 // the start transient has decayed (2 s, 16 times the damping time 1/(zeta w) = 0.12 s of the
-// first axial mode) the tow force is within 1e-3 of F. Catches a tangential drag without its pi (68% low) or 10% off.
+// first axial mode) the tow force is within 1e-3 of F. Catches a tangential drag without its
+// pi (68% low) or 10% off.
 class TowedAlongItsAxis : public ::testing::TestWithParam<Integrator> {};
 
 TEST_P(TowedAlongItsAxis, TowForceIsTheClosedFormTangentialDrag) {
@@ -96,15 +96,15 @@ TEST_P(TowedAlongItsAxis, TowForceIsTheClosedFormTangentialDrag) {
   p.integrator = GetParam();
   const Environment env = Water(false);  // no weight: the line stays on its axis
   Tow s(Make(p, env, "axial,damping,drag"));
-  const double U = 1;  // [m/s]
+  const double U = 1;              // [m/s]
   s.ends.a.axis = Vec3(-1, 0, 0);  // the line trails behind end A, along -x
   s.tether.InitialShape(s.ends, s.x.data(), s.v.data());
   s.SetVelocity(Vec3(U, 0, 0));
   ASSERT_TRUE(s.Run(0.002, 1000));
   const double F = 0.5 * env.water.density * p.Cdt * kPi * p.diameter * U * U * p.length;
   const EndReactions r = s.Reactions();
-  std::printf("%s: tow force %.6g N, closed form %.6g N\n", IntegratorName(GetParam()),
-              r.tension_a, F);
+  std::printf("%s: tow force %.6g N, closed form %.6g N\n", IntegratorName(GetParam()), r.tension_a,
+              F);
   EXPECT_NEAR(r.tension_a / F, 1, 1e-3);
   EXPECT_NEAR(r.force_a.x(), -F, 1e-3 * F);  // drag pulls end A back
 }
@@ -169,7 +169,7 @@ TEST(Holes, SeabedFrictionAlongAndAcrossFollowTheirOwnCoefficients) {
   env.water.seabed_friction_axial = 0.2;  // along
   const double area = kPi * p.diameter * p.diameter / 4;
   const double w = (p.mass_per_length - env.water.density * area) * kG;  // [N/m] wet weight
-  const double pen = w / env.water.seabed_stiffness;  // [m] resting penetration
+  const double pen = w / env.water.seabed_stiffness;                     // [m] resting penetration
   const double U = 0.2, eps = env.water.seabed_friction_speed;
   for (int across = 0; across < 2; ++across) {
     Tow s(Make(p, env, "axial,damping,weight,buoyancy,seabed"));
@@ -183,8 +183,7 @@ TEST(Holes, SeabedFrictionAlongAndAcrossFollowTheirOwnCoefficients) {
     const Vec3 F = r.force_a + r.force_b;
     const double N = F.z() + w * p.length;
     const double mu = -F.dot(u) / (N * std::tanh(U / eps));
-    const double expected =
-        across ? env.water.seabed_friction : env.water.seabed_friction_axial;
+    const double expected = across ? env.water.seabed_friction : env.water.seabed_friction_axial;
     std::printf("dragged %s: mu %.5f (declared %.2f), sum N %.4g N of w L %.4g N\n",
                 across ? "across" : "along", mu, expected, N, w * p.length);
     EXPECT_NEAR(mu, expected, 0.01 * expected) << (across ? "across" : "along");
@@ -295,12 +294,11 @@ TEST(Holes, DeclaredRangesHoldAtTheirBoundaries) {
     const char* at_max;
     const char* above;
   };
-  for (const Bound& b : {Bound{"Cdn=100", "Cdn=100.001"}, Bound{"Cdt=100", "Cdt=100.5"},
-                         Bound{"Can=100", "Can=101"}, Bound{"EI=1e12", "EI=1.01e12"},
-                         Bound{"damping=1e12", "damping=2e12"},
-                         Bound{"max_strain=100", "max_strain=100.5"},
-                         Bound{"max_step=1", "max_step=1.5"}, Bound{"substeps=100000",
-                                                                    "substeps=100001"}}) {
+  for (const Bound& b :
+       {Bound{"Cdn=100", "Cdn=100.001"}, Bound{"Cdt=100", "Cdt=100.5"}, Bound{"Can=100", "Can=101"},
+        Bound{"EI=1e12", "EI=1.01e12"}, Bound{"damping=1e12", "damping=2e12"},
+        Bound{"max_strain=100", "max_strain=100.5"}, Bound{"max_step=1", "max_step=1.5"},
+        Bound{"substeps=100000", "substeps=100001"}}) {
     EXPECT_TRUE(ok(b.at_max)) << b.at_max;
     EXPECT_FALSE(ok(b.above)) << b.above;
   }
@@ -308,12 +306,14 @@ TEST(Holes, DeclaredRangesHoldAtTheirBoundaries) {
     EXPECT_FALSE(ok(zero)) << zero;
   }
   DeclarationError e;
-  EXPECT_FALSE(ParseTether("ends=a,b length=1e5 segments=100000 diameter=10 "
-                           "mass_per_length=1e5 EA=1.1e13",
-                           env, &e));
-  EXPECT_TRUE(ParseTether("ends=a,b length=1e5 segments=100000 diameter=10 "
-                          "mass_per_length=1e5 EA=1e13",
-                          env, &e))
+  EXPECT_FALSE(
+      ParseTether("ends=a,b length=1e5 segments=100000 diameter=10 "
+                  "mass_per_length=1e5 EA=1.1e13",
+                  env, &e));
+  EXPECT_TRUE(
+      ParseTether("ends=a,b length=1e5 segments=100000 diameter=10 "
+                  "mass_per_length=1e5 EA=1e13",
+                  env, &e))
       << e.message;
   EXPECT_FALSE(ParseTether(base + " segments=10.5", env, &e).has_value());
   // The water: friction in [0, 10], density in (0, 1e4].
@@ -345,8 +345,9 @@ TEST(Holes, MuJoCoErrorDuringARunExitsWith3) {
     }
     f << "</worldbody></mujoco>";
   }
-  const int status = std::system((std::string(MJTETHER_CLI) + " run " + model +
-                                  " --duration 1 > " + out + " 2>&1 < /dev/null").c_str());
+  const int status = std::system(
+      (std::string(MJTETHER_CLI) + " run " + model + " --duration 1 > " + out + " 2>&1 < /dev/null")
+          .c_str());
   std::ifstream f(out);
   std::stringstream text;
   text << f.rdbuf();
@@ -422,10 +423,11 @@ TEST(Holes, RovStaticPitchInACurrentBalancesForcesAndMomentsAboutTheCentreOfGrav
     const double mid = 0.5 * (lo + hi);
     (My(mid) * My(lo) > 0 ? lo : hi) = mid;
   }
-  std::printf("t %.1f s: F (%.4f, %.4f, %.4f) N, pitch %.5f rad (statics %.5f), residual "
-              "force %.2e N, moment %.2e N m\n",
-              s.d->time, r.force_b.x(), r.force_b.y(), r.force_b.z(), pitch, 0.5 * (lo + hi),
-              force.norm(), moment.norm());
+  std::printf(
+      "t %.1f s: F (%.4f, %.4f, %.4f) N, pitch %.5f rad (statics %.5f), residual "
+      "force %.2e N, moment %.2e N m\n",
+      s.d->time, r.force_b.x(), r.force_b.y(), r.force_b.z(), pitch, 0.5 * (lo + hi), force.norm(),
+      moment.norm());
   EXPECT_LT(force.norm(), 1e-4);
   EXPECT_LT(moment.norm(), 1e-5);
   EXPECT_NEAR(pitch, 0.5 * (lo + hi), 1e-4);

@@ -242,7 +242,8 @@ TEST(Stress, ZeroTensionLoopIsTheSameWithBothIntegrators) {
 // pile does not collapse onto the chord: some node stands out from it by at least a tenth of
 // a segment, L0/10 = 2 cm (a pile folded flat onto the chord would have every node within
 // round-off of it; how high the pile stands is set by the drag while it forms, 0.29 m
-// measured and 0.20 m with 10% more drag, and is not what this asserts), the energy never rises after the ends stop (1e-6 J of round-off), and it does not
+// measured and 0.20 m with 10% more drag, and is not what this asserts), the energy never
+// rises after the ends stop (1e-6 J of round-off), and it does not
 // jitter: its kinetic energy falls below 1% of the peak while the ends moved (measured 0.2%;
 // quadratic drag slows the last drift).
 TEST_P(Integrators, ZeroTensionWithoutBendingDoesNotJitterOrCollapse) {
