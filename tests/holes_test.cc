@@ -376,13 +376,20 @@ TEST(Holes, MuJoCoErrorDuringARunExitsWith3) {
 // the reaction applied at the body's origin instead of the site (then the ROV does not
 // pitch, and the moment of F about G is left over), a wrong buoyancy or centre of buoyancy,
 // and damping in the wrong frame.
-TEST(Holes, RovStaticPitchInACurrentBalancesForcesAndMomentsAboutTheCentreOfGravity) {
+// The tether is declared both ways (the ROV at end B, then at end A), so that each end's
+// reaction and lever arm is checked.
+class RovStatics : public ::testing::TestWithParam<bool> {};
+
+TEST_P(RovStatics, PitchInACurrentBalancesForcesAndMomentsAboutTheCentreOfGravity) {
+  const bool rov_at_a = GetParam();
   const double rho = 1000, V = 0.0105, mass = 10;
   const Vec3 u(0.5, 0, 0), cob(0, 0, 0.15), site(-0.3, 0, -0.15);
   const Vec3 D(40, 60, 20);
-  testing::LoadedScene s(R"(<mujoco><option timestep="0.002" integrator="Euler"/><custom>
-      <text name="water" data="density=1000 current=0.5,0,0"/>
-      <text name="tether:t" data="ends=anchor,attach length=6 segments=12 diameter=0.02
+  testing::LoadedScene s(std::string(R"(<mujoco><option timestep="0.002" integrator="Euler"/>
+    <custom><text name="water" data="density=1000 current=0.5,0,0"/>
+      <text name="tether:t" data="ends=)") +
+                         (rov_at_a ? "attach,anchor" : "anchor,attach") +
+                         R"( length=6 segments=12 diameter=0.02
             mass_per_length=0.314159 EA=1e5 damping=50 Cdn=1.2 Cdt=0.01 integrator=implicit"/>
       <text name="vehicle:rov" data="volume=0.0105 cob=0,0,0.15
             linear_damping=40,60,20,20,20,20"/></custom>
@@ -404,18 +411,19 @@ TEST(Holes, RovStaticPitchInACurrentBalancesForcesAndMomentsAboutTheCentreOfGrav
   ASSERT_GE(still, 1) << "the ROV did not come to rest by t = " << s.d->time;
   mj_forward(s.m, s.d);
   const EndReactions r = GetReactions(s.m, s.d, 0);
+  const Vec3 pull = rov_at_a ? r.force_a : r.force_b;  // the tether's force on the ROV
   Eigen::Matrix3d R;
   for (int i = 0; i < 9; ++i) R(i / 3, i % 3) = s.d->xmat[9 * body + i];
   const Vec3 G(s.d->xipos + 3 * body), S(s.d->site_xpos + 3 * attach);
   const Vec3 g(0, 0, -kG), B = -rho * V * g;
   const Vec3 damping = R * D.cwiseProduct(R.transpose() * u);  // at rest: v = 0
-  const Vec3 force = r.force_b + mass * g + B + damping;
-  const Vec3 moment = (S - G).cross(r.force_b) + (R * cob).cross(B);
+  const Vec3 force = pull + mass * g + B + damping;
+  const Vec3 moment = (S - G).cross(pull) + (R * cob).cross(B);
   const double pitch = 2 * std::atan2(s.d->qpos[5], s.d->qpos[3]);  // about y
   // The pitch at which the measured force's moment about G vanishes (it stays in the x-z plane).
   auto My = [&](double th) {
     const Eigen::Matrix3d Ry = Eigen::AngleAxisd(th, Vec3::UnitY()).toRotationMatrix();
-    return ((Ry * site).cross(r.force_b) + (Ry * cob).cross(B)).y();
+    return ((Ry * site).cross(pull) + (Ry * cob).cross(B)).y();
   };
   double lo = -0.5, hi = 0.5;
   ASSERT_LT(My(lo) * My(hi), 0);
@@ -426,13 +434,17 @@ TEST(Holes, RovStaticPitchInACurrentBalancesForcesAndMomentsAboutTheCentreOfGrav
   std::printf(
       "t %.1f s: F (%.4f, %.4f, %.4f) N, pitch %.5f rad (statics %.5f), residual "
       "force %.2e N, moment %.2e N m\n",
-      s.d->time, r.force_b.x(), r.force_b.y(), r.force_b.z(), pitch, 0.5 * (lo + hi), force.norm(),
-      moment.norm());
+      s.d->time, pull.x(), pull.y(), pull.z(), pitch, 0.5 * (lo + hi), force.norm(), moment.norm());
   EXPECT_LT(force.norm(), 1e-4);
   EXPECT_LT(moment.norm(), 1e-5);
   EXPECT_NEAR(pitch, 0.5 * (lo + hi), 1e-4);
   EXPECT_GT(std::abs(pitch), 0.05);  // the lever arm matters here (a few degrees)
 }
+
+INSTANTIATE_TEST_SUITE_P(Holes, RovStatics, ::testing::Values(false, true),
+                         [](const ::testing::TestParamInfo<bool>& i) {
+                           return std::string(i.param ? "RovAtEndA" : "RovAtEndB");
+                         });
 
 // ---------------------------------------------------------------------------------------------
 // The clamp moment at end A, on a body. ValidationMuJoCo.EndMomentGivesCircularArc clamps end A
