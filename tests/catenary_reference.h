@@ -12,6 +12,8 @@
 #define MJTETHER_TESTS_CATENARY_REFERENCE_H_
 
 #include <cmath>
+#include <sstream>
+#include <stdexcept>
 
 namespace mjtether::testing {
 
@@ -31,14 +33,21 @@ inline void CatenaryEnd(double H, double V0, double w, double L, double EA, doub
   *z = (V0 * L + w * L * L / 2) / EA + (std::hypot(H, V1) - std::hypot(H, V0)) / w;
 }
 
-// Solves for H and V0 so that end B lands at (span, rise). Requires a sagging cable.
+// Solves for H and V0 so that end B lands at (span, rise) within 1e-13 L. Requires a sagging
+// cable. Throws std::runtime_error if Newton's method does not converge.
 inline Catenary SolveCatenary(double span, double rise, double L, double w, double EA) {
   double H = w * L / 4, V0 = -w * L / 2 + 0.5 * w * rise;
+  bool converged = false;
+  double miss = INFINITY;  // [m] distance of the solution's end B from B
   for (int it = 0; it < 100; ++it) {
     double x, z;
     CatenaryEnd(H, V0, w, L, EA, &x, &z);
     const double rx = x - span, rz = z - rise;
-    if (std::hypot(rx, rz) < 1e-13 * L) break;
+    miss = std::hypot(rx, rz);
+    if (miss < 1e-13 * L) {
+      converged = true;
+      break;
+    }
     const double dH = 1e-7 * H, dV = 1e-7 * (std::abs(V0) + w * L);
     double xh, zh, xv, zv;
     CatenaryEnd(H + dH, V0, w, L, EA, &xh, &zh);
@@ -53,6 +62,15 @@ inline Catenary SolveCatenary(double span, double rise, double L, double w, doub
     }
     H -= stepH;
     V0 -= stepV;
+  }
+  // A reference that did not converge is no reference: the test that asked for it fails
+  // (GoogleTest reports the exception and its message).
+  if (!converged || !std::isfinite(H) || !std::isfinite(V0)) {
+    std::ostringstream s;
+    s << "SolveCatenary(span " << span << ", rise " << rise << ", L " << L << ", w " << w
+      << ", EA " << EA << "): Newton did not converge in 100 iterations (end B missed by "
+      << miss << " m)";
+    throw std::runtime_error(s.str());
   }
   return {H, V0, w, L};
 }

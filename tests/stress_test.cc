@@ -239,8 +239,11 @@ TEST(Stress, ZeroTensionLoopIsTheSameWithBothIntegrators) {
 // Without bending nothing resists folding: a rope pushed from its ends piles up. Its segments
 // keep at least half their rest length (measured 0.81-0.89 L0) and the total length stays
 // within 2% of L (no segment collapses, none stretches: no tension builds up, < 0.01 N), the
-// pile does not collapse onto the chord (nodes stand out at least L/50 from it; measured
-// 0.29 m), the energy never rises after the ends stop (1e-6 J of round-off), and it does not
+// pile does not collapse onto the chord: some node stands out from it by at least a tenth of
+// a segment, L0/10 = 2 cm (a pile folded flat onto the chord would have every node within
+// round-off of it; how high the pile stands is set by the drag while it forms, 0.29 m
+// measured and 0.20 m with 10% more drag, and is not what this asserts), the energy never
+// rises after the ends stop (1e-6 J of round-off), and it does not
 // jitter: its kinetic energy falls below 1% of the peak while the ends moved (measured 0.2%;
 // quadratic drag slows the last drift).
 TEST_P(Integrators, ZeroTensionWithoutBendingDoesNotJitterOrCollapse) {
@@ -252,7 +255,7 @@ TEST_P(Integrators, ZeroTensionWithoutBendingDoesNotJitterOrCollapse) {
       r.speed_end);
   EXPECT_GT(r.min_segment, 0.5);
   EXPECT_NEAR(r.arc, 10, 0.2);
-  EXPECT_GT(r.extent, 0.2);
+  EXPECT_GT(r.extent, 0.1 * 10.0 / 50);  // L0/10
   EXPECT_LT(r.energy_rise, 1e-6);
   EXPECT_LT(r.kinetic_end, 1e-2 * r.kinetic_max);
   EXPECT_LT(r.tension_end, 0.01);

@@ -77,6 +77,10 @@ Elastica ShootElastica(double P, double L, double EI, double EA, double kappa0) 
 
 Elastica SolveElastica(double P, double L, double EI, double EA) {
   double lo = 0, hi = 2 * P * L / EI;  // theta'(L) < 0 at lo, > 0 at hi
+  // The shooting converges only if the bracket holds the root (then 100 halvings leave it
+  // within 2^-100 of the bracket: converged to round-off).
+  EXPECT_LT(ShootElastica(P, L, EI, EA, lo).theta, 0) << "elastica bracket, P " << P;
+  EXPECT_GT(ShootElastica(P, L, EI, EA, hi).theta, 0) << "elastica bracket, P " << P;
   for (int it = 0; it < 100; ++it) {
     const double mid = 0.5 * (lo + hi);
     (ShootElastica(P, L, EI, EA, mid).theta < 0 ? lo : hi) = mid;
@@ -180,6 +184,7 @@ TEST(ValidationMuJoCo, EndMomentGivesCircularArc) {
         ASSERT_TRUE(s.Step());
         settled = s.d->time > 1.5 && s.MaxQvel() < 1e-7;
       }
+      EXPECT_TRUE(settled) << bending << " N " << N << ": still moving at t = " << s.d->time;
       const double angle = s.d->qpos[turn];
       e.emplace_back(N, angle / phi - 1);
       if (N == 20) angle20 = angle;

@@ -90,9 +90,11 @@ Environment Water(double density = 1025) {
   return env;
 }
 
-// Bisection for the root of a function that changes sign on [lo, hi].
+// Bisection for the root of a function that changes sign on [lo, hi] (checked: without a sign
+// change there is no root to converge to, and the test fails).
 double Bisect(const std::function<double(double)>& f, double lo, double hi) {
   const double flo = f(lo);
+  EXPECT_LE(flo * f(hi), 0) << "Bisect: no sign change on [" << lo << ", " << hi << "]";
   for (int it = 0; it < 200; ++it) {
     const double mid = 0.5 * (lo + hi);
     ((f(mid) > 0) == (flo > 0) ? lo : hi) = mid;
@@ -169,11 +171,13 @@ void MooringEnd(double H, double V, double L, double w, double EA, double CB, do
 
 Mooring SolveMooring(double XF, double ZF, double L, double w, double EA) {
   double H = w * L / 4, V = w * L / 2;
-  for (int it = 0; it < 100; ++it) {
+  bool converged = false;
+  for (int it = 0; it < 100 && !converged; ++it) {
     double x, z;
     MooringEnd(H, V, L, w, EA, 0, &x, &z);
     const double rx = x - XF, rz = z - ZF;
-    if (std::hypot(rx, rz) < 1e-13 * L) break;
+    converged = std::hypot(rx, rz) < 1e-13 * L;
+    if (converged) break;
     const double dH = 1e-7 * H, dV = 1e-7 * V;
     double xh, zh, xv, zv;
     MooringEnd(H + dH, V, L, w, EA, 0, &xh, &zh);
@@ -185,6 +189,9 @@ Mooring SolveMooring(double XF, double ZF, double L, double w, double EA) {
     H -= sH;
     V -= sV;
   }
+  // The reference must have converged (end B within 1e-13 L of the fairlead), or it is none.
+  EXPECT_TRUE(converged) << "SolveMooring(" << XF << ", " << ZF << ", " << L << ", " << w
+                         << ", " << EA << "): Newton did not converge";
   return {H, V};
 }
 
