@@ -24,7 +24,7 @@
 #include <cmath>
 #include <string>
 
-#include "mjtether.h"
+#include <mjtether/mjtether.h>
 
 namespace rov {
 
