@@ -3,7 +3,8 @@
 # (CI, .ci/run; a few minutes on 2 cores):
 #   1. CMake package: build with prefix /usr, `cmake --install --prefix TMP` elsewhere, then an
 #      external project (tests/consumer/) with find_package(mjtether) and the examples/ directory
-#      copied out of the repository are built against TMP and run; pkg-config compiles too.
+#      copied out of the repository are built against TMP and run; pkg-config compiles too; a
+#      parent project with add_subdirectory (tests/consumer/parent/) builds the glue only.
 #   2. Debian package: `cpack -G DEB` gives mjtether_<version>_amd64.deb; its file list must
 #      equal tests/consumer/deb_contents.txt and its Depends name Debian packages; the CLI from
 #      the unpacked package runs.
@@ -51,6 +52,17 @@ g++ -O1 -DMODELS_DIR="\"$prefix/share/mjtether/models\"" "$work/src/tests/consum
   -o "$work/consumer_pc"
 "$work/consumer_pc" | tail -1
 "$prefix/bin/mjtether" --version
+
+step "1b. add_subdirectory from a parent project: engine and glue only, no cache forced"
+cmake -S "$work/src/tests/consumer/parent" -B "$work/parent" -DMJTETHER_SOURCE="$work/src" \
+  ${CMAKE_CXX_COMPILER_LAUNCHER:+-DCMAKE_CXX_COMPILER_LAUNCHER=$CMAKE_CXX_COMPILER_LAUNCHER} \
+  >/dev/null
+if [[ -n "$(sed -n 's/^CMAKE_BUILD_TYPE:STRING=//p' "$work/parent/CMakeCache.txt")" ]]; then
+  echo "consumer_check: add_subdirectory(mjtether) set the parent's CMAKE_BUILD_TYPE" >&2
+  exit 1
+fi
+cmake --build "$work/parent" -j"$jobs" >/dev/null
+"$work/parent/consumer" | tail -1
 
 step "3. Python module from the prefix"
 PYTHONPATH="$prefix/lib/python3/dist-packages" "$py" - <<'PY'
