@@ -50,11 +50,10 @@ set(CPACK_PACKAGE_CONTACT "mjtether developers <mjtether@localhost>")
 set(CPACK_GENERATOR DEB)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION science)
-set(CPACK_DEBIAN_PACKAGE_DESCRIPTION "${PROJECT_DESCRIPTION}
- A lumped-mass tether (umbilical, mooring line) simulated inside MuJoCo 2.2 through its
- passive-force callback, with ROV hydrodynamics, thrust schedules and prescribed motion:
- the mjtether command-line tool, C++ libraries with CMake and pkg-config files, the
- Python module and example models.")
+set(CPACK_PACKAGE_DESCRIPTION "A lumped-mass tether (umbilical, mooring line) simulated inside
+MuJoCo 2.2 through its passive-force callback, with ROV hydrodynamics, thrust schedules and
+prescribed motion: the mjtether command-line tool, C++ libraries with CMake and pkg-config
+files, the Python module and example models.")
 # Debian 12 package names. libmujoco-dev and libeigen3-dev: the installed headers and CMake
 # package need them. libosmesa6 is opened with dlopen by the renderer; ffmpeg and gnuplot-nox
 # are run by `mjtether render` and `mjtether plot`.

@@ -86,7 +86,11 @@ test -f "$deb" || { echo "consumer_check: $deb not built" >&2; exit 1; }
 dpkg-deb -c "$deb" | awk '{print $6}' | sed -e 's|^\./|/|' -e 's|/$||' | grep -v '^$' \
   | sed -E 's/cpython-[0-9]+-x86_64-linux-gnu/cpython-XY-x86_64-linux-gnu/' | sort \
   >"$work/deb_contents.txt"
-if ! diff -u "$work/src/tests/consumer/deb_contents.txt" "$work/deb_contents.txt"; then
+# Expected: the listed files plus every file of the checkout's models/ directory.
+{ grep -v '^#' "$work/src/tests/consumer/deb_contents.txt"
+  (cd "$work/src" && find models -mindepth 1 | sed 's|^models|/usr/share/mjtether/models|')
+} | sort >"$work/deb_expected.txt"
+if ! diff -u "$work/deb_expected.txt" "$work/deb_contents.txt"; then
   echo "consumer_check: the .deb's files differ from tests/consumer/deb_contents.txt" >&2
   exit 1
 fi
