@@ -16,6 +16,8 @@
 // tension at the vehicle [N] and its vertical pull [N] (mjtether::GetReactions), and its slack
 // segments (mjtether::GetTensions). Exit status 0 if the depth stayed within --bound [m] of the
 // set-point after the first 5 s, 1 if not, 2 on a load error.
+#include <mjtether/mjtether.h>
+#include <mjtether/version.h>
 #include <mujoco/mujoco.h>
 
 #include <cmath>
@@ -24,9 +26,6 @@
 #include <cstring>
 #include <string>
 #include <vector>
-
-#include <mjtether/mjtether.h>
-#include <mjtether/version.h>
 
 #include "rov_controller.h"
 
@@ -39,7 +38,8 @@ namespace {
 constexpr const char* kUsage =
     "usage: rov_pid [MODEL.xml] [--surge N] [--duration S] [--bound M] [--station]\n"
     "  MODEL.xml   scene with a body 'rov', a tether 'umbilical' and thrusters fr, fl, rr, rl,\n"
-    "              vfr, vfl, vrr, vrl (default: " MJTETHER_MODELS_DIR "/bluerov2_heavy.xml)\n"
+    "              vfr, vfl, vrr, vrl (default: " MJTETHER_MODELS_DIR
+    "/bluerov2_heavy.xml)\n"
     "  --surge N   pilot's surge force after 2 s [N] (default 20)\n"
     "  --duration S  simulated time [s] (default 60)\n"
     "  --bound M   allowed depth error after 5 s [m] (default 0.1)\n"

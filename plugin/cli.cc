@@ -3,11 +3,11 @@
 //
 // Exit codes: 0 success, 1 the simulation diverged, 2 bad input (model, declaration or
 // options), 3 MuJoCo error, 4 an external tool failed.
+#include <mjtether/version.h>
+
 #include <functional>
 #include <string>
 #include <vector>
-
-#include <mjtether/version.h>
 
 #include "cli_command.h"
 #include "mjtether.h"

@@ -5,6 +5,9 @@
 // The module links Debian's libmujoco (the same one as the C++ libraries), so it cannot share a
 // process with another MuJoCo Python package (mjcb_passive is one global pointer per libmujoco).
 #include <dlfcn.h>
+#include <mjtether/mjtether.h>
+#include <mjtether/render.h>
+#include <mjtether/version.h>
 #include <mujoco/mujoco.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -20,10 +23,6 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <mjtether/mjtether.h>
-#include <mjtether/render.h>
-#include <mjtether/version.h>
 
 #include "cli_step.h"  // StepAndCheck: the checks `mjtether run` makes after each step
 
@@ -43,7 +42,9 @@ struct DivergenceError : Error {
 // exception instead. libmujoco is C compiled with unwind tables (x86-64 default), so the
 // exception crosses its frames; the Simulation whose call failed is reset (see Guarded).
 void ThrowMujocoError(const char* message) { throw Error(std::string("MuJoCo error: ") + message); }
-void PrintMujocoWarning(const char* message) { std::fprintf(stderr, "MuJoCo warning: %s\n", message); }
+void PrintMujocoWarning(const char* message) {
+  std::fprintf(stderr, "MuJoCo warning: %s\n", message);
+}
 
 // The model with its tethers attached; shared by a Simulation and its copies.
 struct Model {
@@ -302,8 +303,8 @@ PYBIND11_MODULE(mjtether, mod) {
   mju_user_warning = PrintMujocoWarning;
 
   py::class_<TetherView>(mod, "Tether", "One tether of a Simulation (views into its mjData).")
-      .def_property_readonly("name",
-                             [](const TetherView& t) { return mjtether::TetherName(t.sim->m(), t.k); })
+      .def_property_readonly(
+          "name", [](const TetherView& t) { return mjtether::TetherName(t.sim->m(), t.k); })
       .def_property_readonly("segments", [](const TetherView& t) { return t.tether()->segments(); })
       .def_property_readonly(
           "nodes", [](const TetherView& t) { return t.Nodes(false); },
@@ -331,11 +332,11 @@ PYBIND11_MODULE(mjtether, mod) {
       .def_property_readonly("length", &TetherView::Length,
                              "current length along the nodes [m] (stretched)")
       .def_property_readonly(
-          "rest_length",
-          [](const TetherView& t) { return t.tether()->params().length; },
+          "rest_length", [](const TetherView& t) { return t.tether()->params().length; },
           "declared unstretched length [m]")
       .def_property_readonly(
-          "time", [](const TetherView& t) { return mjtether::TetherTime(t.sim->m(), t.sim->d(), t.k); },
+          "time",
+          [](const TetherView& t) { return mjtether::TetherTime(t.sim->m(), t.sim->d(), t.k); },
           "the tether's own time [s] (its last evaluation)");
 
   py::class_<BodyView>(mod, "Body", "One body of a Simulation (views into its mjData).")
@@ -350,7 +351,9 @@ PYBIND11_MODULE(mjtether, mod) {
           "orientation quaternion w, x, y, z (read-only view)")
       .def_property_readonly(
           "xmat",
-          [](const BodyView& b) { return View(b.sim->d()->xmat + 9 * b.id, {3, 3}, b.owner, false); },
+          [](const BodyView& b) {
+            return View(b.sim->d()->xmat + 9 * b.id, {3, 3}, b.owner, false);
+          },
           "rotation matrix, body to world (read-only view)")
       .def_property_readonly(
           "mocap_pos",
@@ -370,8 +373,8 @@ PYBIND11_MODULE(mjtether, mod) {
                          "An MJCF model with its tethers, vehicles and schedules, and its state.")
       .def(py::init(&Simulation::FromFile), py::arg("path"),
            "Loads an MJCF file; raises mjtether.Error with the CLI's message on bad input.")
-      .def_static("from_xml", &Simulation::FromXml, py::arg("xml"),
-                  py::arg("name") = "<string>", "Loads MJCF text; `name` stands for the file.")
+      .def_static("from_xml", &Simulation::FromXml, py::arg("xml"), py::arg("name") = "<string>",
+                  "Loads MJCF text; `name` stands for the file.")
       .def(
           "step", [](Simulation& s, long long n) { s.Step(n, true); }, py::arg("n") = 1,
           "n steps as `mjtether run` takes them: thrust: and motion: schedules, mj_step, the "

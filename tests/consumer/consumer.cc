@@ -2,15 +2,14 @@
 // 2 s with mjtether::Step (thrust schedules and motions as `mjtether run`), and checks the
 // tether against a conservation law: every segment tension is finite and >= 0, and the end
 // reactions equal the magnitude of the end forces. Exit 0 on success.
+#include <mjtether/mjtether.h>
+#include <mjtether/version.h>
 #include <mujoco/mujoco.h>
 
 #include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
-
-#include <mjtether/mjtether.h>
-#include <mjtether/version.h>
 
 int main() {
   std::printf("mjtether %s on MuJoCo %s\n", MJTETHER_VERSION_STRING, mj_versionString());
@@ -37,8 +36,8 @@ int main() {
   const mjtether::EndReactions r = mjtether::GetReactions(m, d, k);
   // tension_a is |force_a| by definition (src/tether.h): equal to rounding.
   bad += std::abs(r.tension_a - r.force_a.norm()) > 1e-9 * (1 + r.tension_a);
-  std::printf("t = %.3f s: tension at A %.2f N, at B %.2f N, %zu segments\n", d->time,
-              r.tension_a, r.tension_b, T.size());
+  std::printf("t = %.3f s: tension at A %.2f N, at B %.2f N, %zu segments\n", d->time, r.tension_a,
+              r.tension_b, T.size());
   mj_deleteData(d);
   mjtether::Detach(m);
   mj_deleteModel(m);

@@ -1,7 +1,7 @@
 // The renderer's header and library resolve from the installed package (mjtether::render).
-#include <cstdio>
-
 #include <mjtether/render.h>
+
+#include <cstdio>
 
 int main() {
   // NiceCeil is the colour scale's rounding: 130 N rounds up to 200 N (render.h).

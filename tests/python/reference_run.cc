@@ -3,13 +3,12 @@
 // t = 0, then CHUNKS times: STEPS x mjtether::Step, schedules, mj_forward. Prints the time,
 // qpos, qvel and every tether's node positions as C hex floats (%a), one value a line.
 //   reference_run MODEL.xml CHUNKS STEPS
+#include <mjtether/mjtether.h>
 #include <mujoco/mujoco.h>
 
 #include <cstdio>
 #include <cstdlib>
 #include <string>
-
-#include <mjtether/mjtether.h>
 
 int main(int argc, char** argv) {
   if (argc != 4) {
