@@ -18,13 +18,12 @@
 #ifndef MJTETHER_EXAMPLES_ROV_CONTROLLER_H_
 #define MJTETHER_EXAMPLES_ROV_CONTROLLER_H_
 
+#include <mjtether/mjtether.h>
 #include <mujoco/mujoco.h>
 
 #include <algorithm>
 #include <cmath>
 #include <string>
-
-#include "mjtether.h"
 
 namespace rov {
 

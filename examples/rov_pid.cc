@@ -3,7 +3,11 @@
 // installed as MuJoCo's mjcb_control, while the pilot drives it away from the surface boat
 // until its 30 m tether, slack at the start, comes taut.
 //
-//   rov_pid [MODEL.xml] [--surge N] [--duration S] [--bound M] [--station]
+//   rov_pid [MODEL.xml] [--surge N] [--duration S] [--bound M] [--station] [--help]
+//
+// MODEL.xml defaults to bluerov2_heavy.xml in mjtether's models: the source tree's when built
+// with mjtether, the installed ones (share/mjtether/models) when built on its own against an
+// installed mjtether (examples/CMakeLists.txt).
 //
 // --station: hold the initial position (x, y) as well (station keeping; try
 // models/manoeuvre_station_keeping.xml, a 0.3 m/s cross current); the pilot's surge is unused.
@@ -12,6 +16,8 @@
 // tension at the vehicle [N] and its vertical pull [N] (mjtether::GetReactions), and its slack
 // segments (mjtether::GetTensions). Exit status 0 if the depth stayed within --bound [m] of the
 // set-point after the first 5 s, 1 if not, 2 on a load error.
+#include <mjtether/mjtether.h>
+#include <mjtether/version.h>
 #include <mujoco/mujoco.h>
 
 #include <cmath>
@@ -21,10 +27,35 @@
 #include <string>
 #include <vector>
 
-#include "mjtether.h"
 #include "rov_controller.h"
 
+#ifndef MJTETHER_MODELS_DIR
+#define MJTETHER_MODELS_DIR MJTETHER_MODELS_INSTALL_DIR
+#endif
+
 namespace {
+
+constexpr const char* kUsage =
+    "usage: rov_pid [MODEL.xml] [--surge N] [--duration S] [--bound M] [--station]\n"
+    "  MODEL.xml   scene with a body 'rov', a tether 'umbilical' and thrusters fr, fl, rr, rl,\n"
+    "              vfr, vfl, vrr, vrl (default: " MJTETHER_MODELS_DIR
+    "/bluerov2_heavy.xml)\n"
+    "  --surge N   pilot's surge force after 2 s [N] (default 20)\n"
+    "  --duration S  simulated time [s] (default 60)\n"
+    "  --bound M   allowed depth error after 5 s [m] (default 0.1)\n"
+    "  --station   hold the initial x, y too (station keeping)\n"
+    "Exit status: 0 depth held within the bound, 1 not held or diverged, 2 bad input.\n";
+
+// Reads a number option's value; false (with the usage on stderr) if it is not a finite number.
+bool ParseNumber(const char* option, const char* text, double* value) {
+  char* end = nullptr;
+  *value = std::strtod(text, &end);
+  if (end == text || *end != '\0' || !std::isfinite(*value)) {
+    std::fprintf(stderr, "rov_pid: %s expects a number, got '%s'\n%s", option, text, kUsage);
+    return false;
+  }
+  return true;
+}
 
 // mjcb_control is one global function pointer: the controller it calls lives here.
 rov::DepthHeadingController* g_controller = nullptr;
@@ -46,14 +77,21 @@ int main(int argc, char** argv) {
   bool station = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--surge" && i + 1 < argc) {
-      surge = std::atof(argv[++i]);
-    } else if (a == "--duration" && i + 1 < argc) {
-      duration = std::atof(argv[++i]);
-    } else if (a == "--bound" && i + 1 < argc) {
-      bound = std::atof(argv[++i]);
+    const bool has_value = i + 1 < argc;
+    if (a == "--help" || a == "-h") {
+      std::printf("%s", kUsage);
+      return 0;
+    } else if (a == "--surge" && has_value) {
+      if (!ParseNumber("--surge", argv[++i], &surge)) return 2;
+    } else if (a == "--duration" && has_value) {
+      if (!ParseNumber("--duration", argv[++i], &duration)) return 2;
+    } else if (a == "--bound" && has_value) {
+      if (!ParseNumber("--bound", argv[++i], &bound)) return 2;
     } else if (a == "--station") {
       station = true;
+    } else if (!a.empty() && a[0] == '-') {
+      std::fprintf(stderr, "rov_pid: unknown option or missing value: %s\n%s", a.c_str(), kUsage);
+      return 2;
     } else {
       model = a;
     }
