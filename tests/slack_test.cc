@@ -96,7 +96,8 @@ TEST(Slack, SeabedSettlesToTheStaticState) {
     for (size_t q = 1; q < path.size() && node < t.nodes(); ++q) {
       const double len = (path[q] - path[q - 1]).norm();
       while (node < t.nodes() && p.length * node / p.segments <= s + len + 1e-12) {
-        const Vec3 r = path[q - 1] + (path[q] - path[q - 1]) * ((p.length * node / p.segments - s) / len);
+        const Vec3 r =
+            path[q - 1] + (path[q] - path[q - 1]) * ((p.length * node / p.segments - s) / len);
         for (int c = 0; c < 3; ++c) x[3 * node + c] = r[c];
         ++node;
       }
@@ -149,9 +150,10 @@ TEST(Slack, SeabedSettlesToTheStaticState) {
   (void)last;
   const double z_A = 0.5 * (z(0) + z(1));  // the middle of segment 0, where T[0] acts
   const double expected = w * (z_A - zb);
-  std::printf("seabed: %d nodes on the bed, worst penetration error %.3g m, T_A - T_bed %.4f N, "
-              "w (z_A - z_b) %.4f N, T_bed %.4f N\n",
-              on_bed, worst, T[0] - T_bed, expected, T_bed);
+  std::printf(
+      "seabed: %d nodes on the bed, worst penetration error %.3g m, T_A - T_bed %.4f N, "
+      "w (z_A - z_b) %.4f N, T_bed %.4f N\n",
+      on_bed, worst, T[0] - T_bed, expected, T_bed);
   EXPECT_GT(on_bed, p.segments / 2);  // more than half the length lies on the seabed
   EXPECT_LT(worst, 1e-7);
   EXPECT_NEAR((T[0] - T_bed) / expected, 1, 0.01);
@@ -159,9 +161,9 @@ TEST(Slack, SeabedSettlesToTheStaticState) {
 
 // The velocity error each node is left with, |G_i|/m_i, G = M (v+ - v) - h f(x + h v+, v+),
 // for a dry tether without damping (so that ComputeForces is the step's own law).
-double VelocityError(const Tether& t, const std::vector<double>& v0,
-                     const std::vector<double>& x1, const std::vector<double>& v1,
-                     const Ends& ends, double h, std::vector<double>* work) {
+double VelocityError(const Tether& t, const std::vector<double>& v0, const std::vector<double>& x1,
+                     const std::vector<double>& v1, const Ends& ends, double h,
+                     std::vector<double>* work) {
   std::vector<double> f(3 * t.nodes());
   t.ComputeForces(x1.data(), v1.data(), ends, f.data(), nullptr, work->data());
   double worst = 0;
@@ -210,13 +212,14 @@ TEST(Slack, AcceptedStepsSatisfyTheirEquations) {
     double dv_max = 0, T_max = 0;
     for (int i = 1; i < t.segments(); ++i) {
       dv_max = std::max(dv_max, Vec3(v[3 * i] - v0[3 * i], v[3 * i + 1] - v0[3 * i + 1],
-                                     v[3 * i + 2] - v0[3 * i + 2]).norm());
+                                     v[3 * i + 2] - v0[3 * i + 2])
+                                    .norm());
     }
     std::vector<double> T(p.segments);
     t.Tensions(x.data(), v.data(), T.data());
     for (double Tj : T) T_max = std::max(T_max, Tj);
-    const double bound = std::max(1e-2 * dv_max, h * 2 * std::max(0.01 * T_max, 1e-6 * p.EA) /
-                                                     t.node_mass(1));
+    const double bound =
+        std::max(1e-2 * dv_max, h * 2 * std::max(0.01 * T_max, 1e-6 * p.EA) / t.node_mass(1));
     worst_ratio = std::max(worst_ratio, VelocityError(t, v0, x, v, to, h, &work) / bound);
   }
   std::printf("residual: worst velocity error / stated bound %.3g, %.2f solves per step\n",

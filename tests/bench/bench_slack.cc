@@ -95,9 +95,8 @@ void Run(benchmark::State& state, const Tether& t, const std::vector<double>& x0
   }
   (void)cpu;
   const double runs = static_cast<double>(state.iterations());
-  state.counters["us_per_step"] =
-      benchmark::Counter(runs * steps * 1e-6, benchmark::Counter::kIsRate |
-                                                  benchmark::Counter::kInvert);
+  state.counters["us_per_step"] = benchmark::Counter(
+      runs * steps * 1e-6, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
   state.counters["realtime"] =
       benchmark::Counter(runs * steps * kStep, benchmark::Counter::kIsRate);
   state.counters["newton"] = static_cast<double>(newton) / total;
@@ -176,8 +175,9 @@ void Settle(benchmark::State& state, bool seabed) {
   Ends ends;
   std::vector<double> x0, v0;
   SettleStart(t, &ends, &x0, &v0);
-  Run(state, t, x0, v0, static_cast<int>(std::lround(20 / kStep)),
-      [&](double) { return ends; }, seabed ? kSeabed : NAN);
+  Run(
+      state, t, x0, v0, static_cast<int>(std::lround(20 / kStep)), [&](double) { return ends; },
+      seabed ? kSeabed : NAN);
 }
 
 // End B circles in the y-z plane 5 m from end A (radius 1 m, period 4 s), from rest at t = 0
@@ -197,8 +197,7 @@ void Slack(benchmark::State& state, bool wet, double damping) {
       "Cdn=1.2 Cdt=0.01 Can=1 integrator=implicit damping=" +
       std::to_string(damping);
   std::string error;
-  std::optional<Scene> s =
-      Build(wet ? "density=1025 current=0,0.3,0" : "", tether, wet, &error);
+  std::optional<Scene> s = Build(wet ? "density=1025 current=0,0.3,0" : "", tether, wet, &error);
   if (!s) {
     state.SkipWithError(error.c_str());
     return;
