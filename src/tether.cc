@@ -19,6 +19,13 @@ constexpr double kExplicitSafety = 0.8;
 // An implicit step whose linearisation missed more tension than this fraction of the largest
 // (from segments turning within the step) iterates again (see ImplicitStep).
 constexpr double kLinearisationTolerance = 0.01;
+// Where the implicit step's law changed within it, its Newton iteration goes on until every
+// node's velocity error |G_i|/m_i is below this fraction of the step's largest velocity change
+// (see ImplicitStep), with at most kMaxNewton linear solves, and a line search that may shorten
+// a Newton step down to kMinLineSearchStep.
+constexpr double kNewtonTolerance = 1e-2;
+constexpr int kMaxNewton = 12;
+constexpr double kMinLineSearchStep = 1.0 / 64;
 // Kinetic energy above this multiple of EnergyBound() is a blow-up (the bound is already
 // generous; the factor keeps a violent but physical transient, e.g. a whipping free end,
 // clear of it).
@@ -75,10 +82,12 @@ struct Work {
   double* vs;    // 3 x n
   double* x0;    // 3 x n   state at the start of a two-stage step (implicit2)
   double* v0;    // 3 x n
+  double* dv;    // 3 x n   implicit Newton correction (line search)
+  double* vb;    // 3 x n   implicit iterate the line search starts from
   static int Size(int N) {
     const int n = N + 1;
     return 3 * n + 3 * N + N + N + 3 * n + 3 * n + 3 * n + 3 * n + 3 * n +
-           BlockBand::Size(n) + 12 * n;
+           BlockBand::Size(n) + 18 * n;
   }
   Work(double* w, int N) {
     const int n = N + 1;
@@ -96,6 +105,8 @@ struct Work {
     vs = xs + 3 * n;
     x0 = vs + 3 * n;
     v0 = x0 + 3 * n;
+    dv = v0 + 3 * n;
+    vb = dv + 3 * n;
   }
 };
 
@@ -397,20 +408,53 @@ void Tether::SegmentGeometry(ConstNodes x, Nodes t, double* l) const {
 // The law of one segment, from its strain eps, unit tangent t and the velocity difference dv of
 // its ends: EA eps + (damping/L0) t.dv, never negative, when stretched; EAc eps + the same
 // damping, never positive, when shortened with the compression effect; else 0.
-inline double Tether::AxialForce(double eps, const Vec3& t, const Vec3& dv) const {
+//
+// Engagement within an implicit step (engage_h > 0, the step's length [s], for a segment that
+// was on the other side of L0 at the start of the step): the damping acts on the strain rate of
+// the engaged law, d(eps+)/dt (eps+ = max(eps, 0), or min(eps, 0) for compression), whose
+// backward-Euler impulse over the step is damping (eps+ - 0), i.e. the rate is limited to
+// eps/engage_h in magnitude. The instantaneous law would jump from 0 to damping deps/dt as l
+// crosses L0, and the step's equations would then have no root (see ImplicitStep); this one
+// is continuous in l and converges to the same law as the step shrinks.
+inline double Tether::AxialForce(double eps, const Vec3& t, const Vec3& dv,
+                                 double engage_h) const {
   const bool taut = eps > 0;
   if (!taut && !(eps < 0 && Has(kCompression))) return 0;
   double T = (taut ? p_.EA : p_.EAc) * eps;
-  if (Has(kDamping)) T += damping_per_L0_ * t.dot(dv);
+  if (Has(kDamping)) {
+    double rate = t.dot(dv);  // [m/s] L0 deps/dt
+    if (engage_h > 0) {
+      const double engaged = eps * L0_ / engage_h;  // [m/s] L0 eps/h
+      rate = taut ? std::min(rate, engaged) : std::max(rate, engaged);
+    }
+    T += damping_per_L0_ * rate;
+  }
   return taut ? std::max(T, 0.0) : std::min(T, 0.0);
 }
 
 void Tether::AddAxial(ConstNodes x, ConstNodes v, ConstNodes t, const double* l, double* T,
-                      Nodes f) const {
+                      Nodes f, const Start* start) const {
   (void)x;
   const double inv_L0 = 1 / L0_;  // [1/m]
+  const double L0sq = L0_ * L0_;
+  const bool engaging = start && Has(kDamping);
   for (int j = 0; j < N_; ++j) {
-    const double Tj = AxialForce(l[j] * inv_L0 - 1, t.col(j), v.col(j + 1) - v.col(j));
+    double engage_h = 0;
+    Vec3 dv = v.col(j + 1) - v.col(j);
+    if (engaging) {
+      // On the other side of L0 at the start of the step than now?
+      const double ls2 = (start->x.col(j + 1) - start->x.col(j)).squaredNorm();
+      if (l[j] > L0_ ? ls2 <= L0sq : l[j] < L0_ && ls2 >= L0sq) engage_h = start->h;
+      if (start->discrete) {
+        // In the Newton iterations past the first: the backward difference of the engaged
+        // strain over the step, (eps+ - max(eps_start, 0))/h (see ImplicitStep).
+        const double ls = std::sqrt(ls2);
+        const double from = l[j] > L0_ ? std::max(ls, L0_) : std::min(ls, L0_);
+        dv = t.col(j) * ((l[j] - from) / start->h);
+        engage_h = 0;
+      }
+    }
+    const double Tj = AxialForce(l[j] * inv_L0 - 1, t.col(j), dv, engage_h);
     T[j] = std::max(Tj, 0.0);
     f.col(j) += Tj * t.col(j);
     f.col(j + 1) -= Tj * t.col(j);
@@ -491,12 +535,20 @@ void Tether::AddDrag(ConstNodes v, ConstNodes q, const double* l, Nodes f) const
 //   N_i = max(0, k l_i (zb - z_i) - c l_i vz_i),
 // and Coulomb friction smoothed by tanh over the slip speed, separately along the tether's
 // horizontal tangent (mu_axial) and across it (mu).
-void Tether::AddSeabed(ConstNodes x, ConstNodes v, ConstNodes q, Nodes f) const {
+//
+// Within an implicit step (start given), a node that was above the seabed at the start of the
+// step and is in contact at its end has its damping act on d(pen+)/dt, as AxialForce does for
+// a segment crossing L0: the sink rate is limited to pen/h, so that the normal force does not
+// jump from 0 to c |vz| at first contact.
+void Tether::AddSeabed(ConstNodes x, ConstNodes v, ConstNodes q, Nodes f,
+                       const Start* start) const {
   const Water& w = env_.water;
   for (int i = 0; i <= N_; ++i) {
     const double pen = w.seabed - x(2, i);
     if (pen <= 0) continue;
-    const double N = std::max(0.0, share_(i) * (seabed_k_ * pen - seabed_c_ * v(2, i)));
+    double sink = -v(2, i);  // [m/s]
+    if (start && start->x(2, i) >= w.seabed) sink = std::min(sink, pen / start->h);
+    const double N = std::max(0.0, share_(i) * (seabed_k_ * pen + seabed_c_ * sink));
     f(2, i) += N;
     if (w.seabed_friction == 0 && w.seabed_friction_axial == 0) continue;
     Vec3 qh(q(0, i), q(1, i), 0);
@@ -574,6 +626,11 @@ void Tether::AccumulateContactImpulse(const double* x, const double* v, const En
 
 void Tether::ComputeForces(const double* xp, const double* vp, const Ends& ends, double* fp,
                            double* Tp, double* work) const {
+  Forces(xp, vp, ends, fp, Tp, work, nullptr);
+}
+
+void Tether::Forces(const double* xp, const double* vp, const Ends& ends, double* fp, double* Tp,
+                    double* work, const Start* start) const {
   Work w(work, N_);
   const int n = N_ + 1;
   ConstNodes x(xp, 3, n), v(vp, 3, n);
@@ -583,7 +640,7 @@ void Tether::ComputeForces(const double* xp, const double* vp, const Ends& ends,
   f.setZero();
   SegmentGeometry(x, t, w.l);
   std::fill(T, T + N_, 0.0);
-  if (Has(kAxial)) AddAxial(x, v, tc, w.l, T, f);
+  if (Has(kAxial)) AddAxial(x, v, tc, w.l, T, f, start);
   if (Has(kBending)) {
     BendingMoments(tc, ends, M);
     AddBending(tc, w.l, Mc, f);
@@ -591,7 +648,7 @@ void Tether::ComputeForces(const double* xp, const double* vp, const Ends& ends,
   if (Has(kWeight) || Has(kBuoyancy)) f += weight_;
   if (Has(kDrag) || Has(kAddedMass) || Has(kSeabed)) NodeTangents(x, tc, q);
   if (Has(kDrag)) AddDrag(v, qc, w.l, f);
-  if (Has(kSeabed)) AddSeabed(x, v, qc, f);
+  if (Has(kSeabed)) AddSeabed(x, v, qc, f, start);
   if (Has(kContact) && ends.contacts) AddContact(x, v, ends, f);
 }
 
@@ -683,7 +740,7 @@ void Tether::Tensions(const double* xp, const double* vp, double* T) const {
     const double l = dx.norm();
     T[j] = 0;
     if (Has(kAxial) && l > L0_) {
-      T[j] = AxialForce(l * inv_L0 - 1, dx * (1 / l), v.col(j + 1) - v.col(j));
+      T[j] = AxialForce(l * inv_L0 - 1, dx * (1 / l), v.col(j + 1) - v.col(j), 0);
     }
   }
 }
@@ -820,11 +877,32 @@ void Tether::Rk4Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double
 //   G(v+) = M (v+ - v) - h f(x + h v+, v+) = 0,
 //   (M - h D - h^2 K) dv = -G,   K = df/dx, D = df/dv at the current iterate,
 // starting from v+ = v with the attached ends already at their positions and velocities at
-// the end of the step. The linear system is the one of Baraff & Witkin (SIGGRAPH 1998); with
-// smooth forces one iteration suffices. The tension-only law is not smooth: a segment that
-// changes between slack and taut during the step invalidates the linearisation, so the
-// iteration repeats (at most kMaxNewton times) until the set of taut segments settles.
-// Returns false if it did not settle (the caller then retries the step in two halves).
+// the end of the step. The linear system is the one of Baraff & Witkin (SIGGRAPH 1998).
+//
+// With smooth forces one iteration suffices (linearly implicit Euler) and the step takes it
+// when no segment changed between slack (or compressed) and taut within it and the tension
+// that segments turning within the step made the linearisation miss stays below
+// kLinearisationTolerance of the largest. Otherwise the law that applies changed at l = L0
+// (from nothing or EAc to EA): G is only piecewise smooth there, with kinks where a segment
+// goes slack, a damped tension is clipped at zero or a node touches the seabed. (It has no
+// jumps: a segment or a seabed contact that engages within the step takes the engaged damping
+// law of AxialForce and AddSeabed, without which G jumps by h damping deps/dt as l crosses L0
+// and has no root at all.) In these iterations the axial damping acts on the backward
+// difference of the engaged strain over the step, (eps+ - max(eps, 0))/h, instead of
+// t+ . (v+_{j+1} - v+_j)/L0: the two differ by l theta^2/(2 h L0) for a segment turning by
+// theta in the step (first order in h, as backward Euler itself), but the difference depends
+// on the lengths only, so its Jacobian is the symmetric (EA + damping/h)/L0 t t^T the matrix
+// holds, where the rate along the turning tangent adds a non-symmetric term (damping h/(L0 l))
+// t (P dv)^T that the matrix cannot hold and without which heavily damped slack tethers made
+// the line search fail. The iteration then goes on as a semismooth Newton method (Qi & Sun,
+// Math. Programming 58, 1993: the Jacobian of the piece the iterate is on is an element of
+// the generalised Jacobian) with a backtracking line search on the merit function
+// phi = 1/2 sum_i |G_i|^2/m_i (Armijo; Nocedal & Wright, Numerical Optimization, 2006, ch. 3
+// and 11), which stops the slack/taut cycling of the plain iteration: each accepted iterate
+// lowers phi. It stops when every node's velocity error |G_i|/m_i is below
+// kNewtonTolerance of the largest velocity change of the step (plus a round-off floor).
+// Returns false if it stalled (kMaxNewton iterations, or a line search that found no descent);
+// the caller then retries the step in two halves and counts it.
 //
 // K holds the axial stiffness EA/L0 t t^T + T/l (I - t t^T) of taut segments, the small-angle
 // bending stiffness EI/w g g^T (g the second-difference stencil of the curvature), and the
@@ -833,9 +911,8 @@ void Tether::Rk4Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double
 // (3x3 blocks, two off-diagonals with bending, one without): a block Cholesky with fixed-size
 // 3x3 blocks (block_band.h) solves it, assembled directly block by block.
 bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
-                          double* work) const {
+                          double* work, StepStatus* stats) const {
   (void)now;
-  constexpr int kMaxNewton = 4;
   Work w(work, N_);
   const int n = N_ + 1;
   const int nu = N_ - 1 + (p_.free_end ? 1 : 0);  // dynamic nodes 1..nu, unknown u = i - 1
@@ -857,26 +934,46 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   }
   ConstNodes f(w.f, 3, n), t(w.t, 3, N_), q(w.q, 3, n);
   BlockBand A(w.band, nu, Has(kBending) ? 2 : 1);
-  Nodes rhs(w.rhs, 3, nu);
+  Nodes rhs(w.rhs, 3, nu), dv(w.dv, 3, nu), vb(w.vb, 3, nu);
   const Mat3 I = Mat3::Identity();
   const double h2 = h * h;
+  const bool added = Has(kAddedMass);
+  Start start{ConstNodes(x.data(), 3, n), h, false};
 
-  bool settled = false;
-  for (int iter = 0; iter < kMaxNewton && !settled; ++iter) {
-    ComputeForces(w.x2, w.v2, next, w.f, w.T, work);
+  // Forces at the iterate, and the residual -G = h f - M (v+ - v) (node mass with normal added
+  // mass) into rhs. Returns phi*2 and, in *err, the largest |G_i|/m_i [m/s].
+  auto residual = [&](double* err) {
+    place();
+    Forces(w.x2, w.v2, next, w.f, w.T, work, &start);
+    double phi = 0, worst = 0;
+    for (int i = 1; i <= nu; ++i) {
+      const Vec3 dvi = vk.col(i) - v.col(i);
+      Vec3 r = h * f.col(i) - mass_(i) * dvi;
+      if (added) {
+        const Vec3 qi = q.col(i);
+        r -= added_(i) * (dvi - qi.dot(dvi) * qi);
+      }
+      rhs.col(i - 1) = r;
+      const double r2 = r.squaredNorm();
+      phi += r2 * inv_mass_(i);
+      worst = std::max(worst, r2 * inv_mass_(i) * inv_mass_(i));
+    }
+    *err = std::sqrt(worst);
+    return phi;
+  };
+
+  // The matrix M - h D - h^2 K at the iterate of the last residual, factored; the Newton
+  // correction replaces the residual in rhs. False if the factorisation failed.
+  bool newton = false;  // past the first iteration
+  auto solve = [&]() {
     A.SetZero();
-    // Node mass with normal added mass; residual -G = h f - M (v+ - v).
-    const bool added = Has(kAddedMass);
     for (int i = 1; i <= nu; ++i) {
       BlockBand::Block d = A.D(i - 1);
-      const Vec3 dv = vk.col(i) - v.col(i);
       if (added) {
         const Vec3 qi = q.col(i);
         d = mass_(i) * I + added_(i) * (I - qi * qi.transpose());
-        rhs.col(i - 1) = h * f.col(i) - d * dv;
       } else {
         d.diagonal().setConstant(mass_(i));
-        rhs.col(i - 1) = h * f.col(i) - mass_(i) * dv;
       }
     }
     // Axial stiffness and damping of taut segments: B = h D + h^2 K with
@@ -896,6 +993,11 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         const Vec3 tj = t.col(j);
         Mat3 B;
         if (taut) {
+          // In the Newton iterations after the first, a taut segment whose damped tension is
+          // clipped at zero (it shortens faster than EA eps/damping) is on the piece where
+          // the law is 0: its Jacobian there is 0 (the first keeps the linearly implicit step's
+          // matrix of before).
+          if (newton && !(w.T[j] > 0)) continue;
           const double geo = h2 * w.T[j] / w.l[j];
           const double along = h2 * ka + (w.T[j] > 0 ? h * ca : 0) - geo;
           B = along * tj * tj.transpose() + geo * I;
@@ -1012,32 +1114,42 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         if (d0 && d1) A.L1(j) += (wa * wb) * B;
       }
     }
-    // Solve; a failed factorisation leaves NaN behind for the divergence check to report.
-    if (A.Factor() >= 0) {
-      vk.col(1).setConstant(NAN);
-      settled = true;  // nothing to retry: the divergence check reports it
-      break;
-    }
+    if (A.Factor() >= 0) return false;
     A.Solve(w.rhs);
-    for (int i = 1; i <= nu; ++i) vk.col(i) += rhs.col(i - 1);
-    // Did a segment change between slack (or compressed) and taut? Then the linearisation was
-    // wrong there: the law changes at l = L0 (from nothing or EAc to EA).
-    place();
-    bool changed = false;
-    const double L0sq = L0_ * L0_;
-    for (int j = 0; j < N_ && !changed; ++j) {
-      changed = ((xk.col(j + 1) - xk.col(j)).squaredNorm() > L0sq) != (w.l[j] > L0_);
+    ++stats->newton_iterations;
+    return true;
+  };
+  // A failed factorisation leaves NaN behind for the divergence check to report.
+  auto fail = [&]() {
+    vk.col(1).setConstant(NAN);
+    x = xk;
+    v = vk;
+    return true;  // nothing to retry
+  };
+
+  // The iterate xk, vk just moved by a full Newton step from the iterate the matrix was
+  // assembled at (whose segment lengths, tangents and tensions are still in w.l, t, w.T): was
+  // the linearisation right? Not if a segment changed between slack (or compressed) and taut:
+  // the law changes at l = L0 (from nothing or EAc to EA). Nor if segments turned so far that
+  // the linearisation missed tension: it took each taut segment's new length as
+  // l + t . d(dx), along its tangent at the start; a segment that turns by theta in the step
+  // is longer than that by about l theta^2/2. Where that would exceed kLinearisationTolerance
+  // of the largest tension (or a microstrain), the step was too long for the linearisation.
+  // (Without this, the fixed line at 160 segments and 50 ms steps went wrong by 3.6 kN RMS,
+  // not 60 N.)
+  const double L0sq = L0_ * L0_;
+  auto linearisation_held = [&]() {
+    for (int j = 0; j < N_; ++j) {
+      if (((xk.col(j + 1) - xk.col(j)).squaredNorm() > L0sq) != (w.l[j] > L0_)) return false;
     }
-    settled = !changed;
-    // Friction saturates over the slip speed eps: where the slip of a contact in the solve
-    // changed the friction's tanh by more than 0.1, the linearisation was not good for it
-    // (a tether starting to slide): iterate again from the new iterate.
-    if (settled && Has(kContact) && next.contacts && p_.contact_friction > 0) {
+    // Friction saturates over the slip speed eps: where the slip of a contact changed the
+    // friction's tanh by more than 0.1 in the full Newton step just taken (rhs still holds it),
+    // the linearisation was not good for it (a tether starting to slide).
+    if (Has(kContact) && next.contacts && p_.contact_friction > 0) {
       const ContactSet& set = *next.contacts;
       const double eps = p_.contact_friction_speed;
-      for (int k = 0; k < set.count && settled; ++k) {
+      for (int k = 0; k < set.count; ++k) {
         const ContactPoint& c = set.points[k];
-        // Node velocity after the solve, and before it (the solve added rhs to it).
         auto node_v = [&](int i, bool after) -> Vec3 {
           if (after || !Dynamic(i)) return vk.col(i);
           return vk.col(i) - rhs.col(i - 1);
@@ -1047,52 +1159,100 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
                           c.s * node_v(c.segment + 1, after) - c.velocity;
           return (vr - c.normal.dot(vr) * c.normal).norm();
         };
-        settled = std::abs(std::tanh(slip(true) / eps) - std::tanh(slip(false) / eps)) <= 0.1;
+        if (std::abs(std::tanh(slip(true) / eps) - std::tanh(slip(false) / eps)) > 0.1) {
+          return false;
+        }
       }
     }
-    // The linearisation also took each taut segment's new length as l + t . d(dx), along its
-    // tangent at the start; a segment that turns by theta in the step is longer than that by
-    // about l theta^2/2, which is tension the solve did not see. Where that would exceed
-    // kLinearisationTolerance of the largest tension (or a microstrain), the step was too long
-    // for the linearisation at the start: iterate again from the new iterate. (Without this,
-    // the fixed line at 160 segments and 50 ms steps went wrong by 3.6 kN RMS, not 60 N.)
-    if (settled && Has(kAxial)) {
-      double T_max = 0, missed = 0;
-      for (int j = 0; j < N_; ++j) T_max = std::max(T_max, w.T[j]);
-      for (int j = 0; j < N_; ++j) {
-        if (!(w.l[j] > L0_)) continue;
-        const Vec3 dx = xk.col(j + 1) - xk.col(j);
-        missed = std::max(missed, p_.EA / L0_ * (dx.norm() - t.col(j).dot(dx)));
-      }
-      settled = missed <= std::max(kLinearisationTolerance * T_max, 1e-6 * p_.EA);
+    if (!Has(kAxial)) return true;
+    double T_max = 0, missed = 0;
+    for (int j = 0; j < N_; ++j) {
+      T_max = std::max(T_max, w.T[j]);
+      if (!(w.l[j] > L0_)) continue;
+      const Vec3 d = xk.col(j + 1) - xk.col(j);
+      missed = std::max(missed, p_.EA / L0_ * (d.norm() - t.col(j).dot(d)));
     }
+    return missed <= std::max(kLinearisationTolerance * T_max, 1e-6 * p_.EA);
+  };
+
+  // First iteration: the linearly implicit step.
+  double err = 0;
+  double phi = residual(&err);
+  if (!solve()) return fail();
+  for (int i = 1; i <= nu; ++i) vk.col(i) += rhs.col(i - 1);
+  place();
+  if (linearisation_held()) {
+    x = xk;
+    v = vk;
+    return true;
+  }
+
+  // Semismooth Newton with a line search on phi, until a full Newton step holds its
+  // linearisation as above, or the velocity error is below kNewtonTolerance of the step's
+  // largest velocity change. The round-off floor: the net force at a node is a sum of terms up
+  // to the largest tension or weight, each exact to ~1e-16 of itself.
+  double dv_max = 0, W_max = 0, m_min = INFINITY, T_max = 0;
+  for (int i = 1; i <= nu; ++i) {
+    dv_max = std::max(dv_max, (vk.col(i) - v.col(i)).squaredNorm());
+    W_max = std::max(W_max, weight_.col(i).norm());
+    m_min = std::min(m_min, mass_(i));
+  }
+  for (int j = 0; j < N_; ++j) T_max = std::max(T_max, w.T[j]);
+  const double tolerance =
+      kNewtonTolerance * std::sqrt(dv_max) + 1e-12 * h * (2 * T_max + W_max) / m_min;
+  start.discrete = true;
+  phi = residual(&err);
+  newton = true;
+  for (int iter = 1; err > tolerance; ++iter) {
+    if (iter == kMaxNewton) return false;
+    if (!solve()) return fail();
+    dv = rhs;
+    for (int i = 1; i <= nu; ++i) vb.col(i - 1) = vk.col(i);
+    for (int i = 1; i <= nu; ++i) vk.col(i) += dv.col(i - 1);
+    place();
+    if (linearisation_held()) break;
+    // Backtracking (Armijo, sigma = 1e-4): phi(alpha) <= (1 - 2 sigma alpha) phi(0), the
+    // directional derivative of phi along an exact Newton step being -2 phi(0).
+    double alpha = 1, trial = 0;
+    for (;;) {
+      trial = residual(&err);
+      if (trial <= (1 - 2e-4 * alpha) * phi) break;
+      alpha *= 0.5;
+      if (alpha < kMinLineSearchStep) return false;
+      for (int i = 1; i <= nu; ++i) vk.col(i) = vb.col(i - 1) + alpha * dv.col(i - 1);
+    }
+    phi = trial;
   }
   x = xk;
   v = vk;
-  return settled;
+  return true;
 }
 
 // An implicit step whose Newton iteration did not settle is redone as two half steps (the
 // ends at the midpoint from the same Hermite curve), down to 1/2^kMaxHalvings of the step;
 // at that depth the last iterate is accepted.
 void Tether::ImplicitStepAdaptive(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
-                                  int depth, double* work, double impulse_weight) const {
+                                  int depth, double* work, StepStatus* stats,
+                                  double impulse_weight) const {
   constexpr int kMaxHalvings = 8;
   Work w(work, N_);
   const int n = N_ + 1;
   Nodes xs(w.xs, 3, n), vs(w.vs, 3, n);
   xs = x;
   vs = v;
-  if (ImplicitStep(x, v, now, next, h, work) || depth == kMaxHalvings) {
+  const bool converged = ImplicitStep(x, v, now, next, h, work, stats);
+  if (converged || depth == kMaxHalvings) {
+    if (!converged) ++stats->stalled_steps;
     // Backward Euler: M (v+ - v) = h f(x+, v+), so the impulse is h times the final force.
     AccumulateContactImpulse(x.data(), v.data(), next, impulse_weight * h, false);
     return;
   }
+  ++stats->halvings;
   x = xs;
   v = vs;
   const Ends mid = Interpolate(now, next, h, 0.5);
-  ImplicitStepAdaptive(x, v, now, mid, h / 2, depth + 1, work, impulse_weight);
-  ImplicitStepAdaptive(x, v, mid, next, h / 2, depth + 1, work, impulse_weight);
+  ImplicitStepAdaptive(x, v, now, mid, h / 2, depth + 1, work, stats, impulse_weight);
+  ImplicitStepAdaptive(x, v, mid, next, h / 2, depth + 1, work, stats, impulse_weight);
 }
 
 // Two-stage, stiffly accurate, L-stable SDIRK of order 2 (Alexander, SIAM J. Numer. Anal. 14,
@@ -1105,7 +1265,7 @@ void Tether::ImplicitStepAdaptive(Nodes x, Nodes v, const Ends& now, const Ends&
 // damping of its first axial modes; this scheme's error is O(h^2) and its damping O((w h)^3),
 // and it still removes the unresolved axial modes (L-stable).
 void Tether::Sdirk2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
-                        double* work) const {
+                        double* work, StepStatus* stats) const {
   constexpr double kGamma = 0.29289321881345247560;  // 1 - 1/sqrt(2)
   Work w(work, N_);
   const int n = N_ + 1;
@@ -1119,9 +1279,9 @@ void Tether::Sdirk2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, dou
   auto fall_back = [&]() {
     x = x0;
     v = v0;
-    ImplicitStepAdaptive(x, v, now, next, h, 0, work);
+    ImplicitStepAdaptive(x, v, now, next, h, 0, work, stats);
   };
-  if (!ImplicitStep(x, v, now, mid, kGamma * h, work)) return fall_back();
+  if (!ImplicitStep(x, v, now, mid, kGamma * h, work, stats)) return fall_back();
   // Contact impulse: y+ = y + (1 - gamma) h F(Y1) + gamma h F(Y2); the first part is kept
   // aside until the second stage settles (a fallback replaces both).
   if (Has(kContact) && mid.contacts) {
@@ -1135,7 +1295,7 @@ void Tether::Sdirk2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, dou
     x.col(i) = x0.col(i) + (1 - kGamma) * h * v.col(i);
     v.col(i) = v0.col(i) + a * (v.col(i) - v0.col(i));
   }
-  if (!ImplicitStep(x, v, mid, next, kGamma * h, work)) return fall_back();
+  if (!ImplicitStep(x, v, mid, next, kGamma * h, work, stats)) return fall_back();
   if (Has(kContact) && next.contacts) {
     for (int k = 0; k < next.contacts->count; ++k) {
       ContactPoint& c = next.contacts->points[k];
@@ -1162,25 +1322,28 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
     } else if (p_.integrator == Integrator::kRK4) {
       Rk4Step(x, v, now, next, h, work);
     } else if (p_.integrator == Integrator::kImplicit2) {
-      Sdirk2Step(x, v, now, next, h, work);
+      Sdirk2Step(x, v, now, next, h, work, &status);
     } else {
-      ImplicitStepAdaptive(x, v, now, next, h, 0, work);
+      ImplicitStepAdaptive(x, v, now, next, h, 0, work, &status);
     }
     now = next;
   }
   // Divergence: a non-finite value, or a strain no tether survives.
   for (int i = 0; i < n; ++i) {
     if (!x.col(i).allFinite() || !v.col(i).allFinite()) {
-      status = {false, i, "non-finite position or velocity"};
+      status.ok = false;
+      status.node = i;
+      status.reason = "non-finite position or velocity";
       return status;
     }
   }
   for (int j = 0; j < N_; ++j) {
     const double strain = (x.col(j + 1) - x.col(j)).norm() / L0_ - 1;
     if (strain > p_.max_strain) {
-      status = {false, j + 1,
-                "strain " + std::to_string(strain) + " of segment " + std::to_string(j) +
-                    " exceeds max_strain " + std::to_string(p_.max_strain)};
+      status.ok = false;
+      status.node = j + 1;
+      status.reason = "strain " + std::to_string(strain) + " of segment " + std::to_string(j) +
+                      " exceeds max_strain " + std::to_string(p_.max_strain);
       return status;
     }
   }
@@ -1196,10 +1359,11 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
   }
   const double bound = kEnergyBlowUp * EnergyBound(from, to);
   if (kinetic > bound) {
-    status = {false, fastest,
-              "kinetic energy " + std::to_string(kinetic) + " J exceeds " +
-                  std::to_string(bound) + " J, " + std::to_string(kEnergyBlowUp) +
-                  " times the most the tether can physically hold"};
+    status.ok = false;
+    status.node = fastest;
+    status.reason = "kinetic energy " + std::to_string(kinetic) + " J exceeds " +
+                    std::to_string(bound) + " J, " + std::to_string(kEnergyBlowUp) +
+                    " times the most the tether can physically hold";
   }
   return status;
 }

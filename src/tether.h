@@ -63,6 +63,10 @@ struct StepStatus {
   bool ok = true;
   int node = -1;         // first offending node
   std::string reason;    // "non-finite position", "strain 1.3 > max_strain 1", ...
+  // How the implicit schemes' Newton iterations went over this Advance (zero otherwise).
+  int newton_iterations = 0;  // linear solves, over all steps and stages
+  int halvings = 0;           // steps (or half steps) redone as two halves
+  int stalled_steps = 0;      // steps accepted with the Newton iteration not converged
 };
 
 class Tether {
@@ -129,16 +133,27 @@ class Tether {
  private:
   Tether() = default;
 
+  // The start of an implicit step of length h [s] (state x at its start): segments and seabed
+  // contacts that engage within the step take the engaged damping law (see AxialForce).
+  struct Start {
+    ConstNodes x;  // 3 x n
+    double h;      // [s]
+    bool discrete;  // damping on the backward difference of the strain over the step
+                    // (the Newton iterations past the first, see ImplicitStep)
+  };
+  // ComputeForces, with the implicit step's start when `start` is not null.
+  void Forces(const double* x, const double* v, const Ends& ends, double* f, double* T,
+              double* work, const Start* start) const;
   // Per-effect terms; each adds to f (3 x n). See tether.cc for the equations.
   void SegmentGeometry(ConstNodes x, Nodes t, double* l) const;
-  double AxialForce(double eps, const Vec3& t, const Vec3& dv) const;
+  double AxialForce(double eps, const Vec3& t, const Vec3& dv, double engage_h) const;
   void AddAxial(ConstNodes x, ConstNodes v, ConstNodes t, const double* l, double* T,
-                Nodes f) const;
+                Nodes f, const Start* start) const;
   void BendingMoments(ConstNodes t, const Ends& ends, Nodes M) const;
   void AddBending(ConstNodes t, const double* l, ConstNodes M, Nodes f) const;
   void NodeTangents(ConstNodes x, ConstNodes t, Nodes q) const;
   void AddDrag(ConstNodes v, ConstNodes q, const double* l, Nodes f) const;
-  void AddSeabed(ConstNodes x, ConstNodes v, ConstNodes q, Nodes f) const;
+  void AddSeabed(ConstNodes x, ConstNodes v, ConstNodes q, Nodes f, const Start* start) const;
   Vec3 ContactForce(const ContactPoint& c, const double* xp, const double* vp, double dt_ref,
                     double* normal_force) const;
   void AddContact(ConstNodes x, ConstNodes v, const Ends& ends, Nodes f) const;
@@ -153,12 +168,13 @@ class Tether {
   void Rk4Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
                double* work) const;
   bool ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
-                    double* work) const;
+                    double* work, StepStatus* stats) const;
   void ImplicitStepAdaptive(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
-                            int depth, double* work, double impulse_weight = 1) const;
+                            int depth, double* work, StepStatus* stats,
+                            double impulse_weight = 1) const;
 
   void Sdirk2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
-                  double* work) const;
+                  double* work, StepStatus* stats) const;
 
   bool Has(unsigned effect) const { return (p_.effects & effect) != 0; }
   bool Dynamic(int i) const { return i > 0 && (i < N_ || p_.free_end); }

@@ -27,7 +27,7 @@ namespace {
 
 const char* kAll = "axial,damping,bending,weight,buoyancy,drag,added_mass,current,seabed";
 // The seabed is declared below the tether: its cost here is the per-node contact test. (With
-// the slack tether lying on it, the implicit step's retries in halves dominate: see README.)
+// the slack tether lying on it, see bench_slack and docs/numerics_slack.md.)
 const char* kWater = "density=1025 current=0.3,0,0 seabed=-20 seabed_friction=0.3";
 const char* kCoefficients =
     "diameter=0.02 mass_per_length=0.35 EA=2e5 EI=0.5 damping=50 Cdn=1.2 Cdt=0.01 Can=1";
