@@ -282,21 +282,22 @@ bool Advise(const Tether& t, double timestep, std::string* warning, std::string*
 }
 
 // Start-up checks at load time (README "Initial shape"). Thresholds:
-// - a mean density mass_per_length / (pi d^2/4) below kMinDensity: no cable, rope or umbilical
-//   is lighter than the lightest structural foams (~30-50 kg/m^3); a diameter given in
-//   millimetres gives 1e-3 kg/m^3 or less, and a buoyancy 1e6 times the weight;
+// - in water, a mean density mass_per_length / (pi d^2/4) below kMinDensity, that of air: no
+//   cable is lighter than air, while a diameter given in millimetres (the key's range stops at
+//   10 m, so 1-10 for 1-10 mm) gives 1e-3-1e-2 kg/m^3, a buoyancy 1e5-1e6 times the weight
+//   (dry, the diameter acts on nothing, and a near-massless dry line is a legitimate test);
 // - a diameter larger than the length: no longer a slender line (Morison drag per length,
 //   buoyancy of a cylinder);
 // - a rest segment length below kMinSegmentPerDiameter d: a cable cannot bend over less than
 //   several diameters (its minimum bend radius), so such nodes resolve nothing physical, and
 //   the lumped cylinder per node is wider than it is long (the hard-case suite checks d/5
 //   against Irvine's catenary; d/10 is the limit kept).
-constexpr double kMinDensity = 50;             // [kg/m^3]
+constexpr double kMinDensity = 1.2;            // [kg/m^3] air
 constexpr double kMinSegmentPerDiameter = 0.1;  // [-] L0 / d
 // A start stretched beyond this strain is far from equilibrium: warned with its tension.
 constexpr double kStretchWarning = 1e-3;  // [-]
 
-bool CheckParameters(const TetherParams& p, std::string* error) {
+bool CheckParameters(const TetherParams& p, bool wet, std::string* error) {
   std::ostringstream s;
   const double area = 3.14159265358979323846 * p.diameter * p.diameter / 4;
   const double density = p.mass_per_length / area;
@@ -304,10 +305,10 @@ bool CheckParameters(const TetherParams& p, std::string* error) {
     s << "key 'diameter' = " << p.diameter << " m is larger than the tether's length "
       << p.length << " m: a lumped-mass line needs a slender tether (diameter in metres, not "
       << "millimetres?)";
-  } else if (density < kMinDensity) {
+  } else if (wet && density < kMinDensity) {
     s << "key 'diameter' = " << p.diameter << " m with mass_per_length = " << p.mass_per_length
       << " kg/m means a mean density of " << density << " kg/m^3, below " << kMinDensity
-      << " kg/m^3 (lighter than any cable; its buoyancy would be " << 1025 / density
+      << " kg/m^3 (lighter than air; its buoyancy would be " << 1025 / density
       << " times its weight in water): give the diameter in metres";
   } else if (p.length / p.segments < kMinSegmentPerDiameter * p.diameter) {
     s << "key 'segments' = " << p.segments << " makes segments of " << p.length / p.segments
@@ -423,6 +424,16 @@ std::string Diagnose(const mjModel* m, const mjData* d, const Environment& env,
         << " N; reduce the thrust (or its schedule) below that, or raise EA";
       return s.str();
     }
+    // A load taken up suddenly (slack pulled taut, a thrust stepped on) overshoots its static
+    // strain up to twice (undamped spring under a step load).
+    if (thrust >= 0.5 * holds) {
+      s << "a snap load: the actuators push body '" << body_name(end) << "' with " << thrust
+        << " N, more than half of EA x max_strain = " << holds
+        << " N, and a load taken up suddenly overshoots its static strain up to twice; reduce "
+           "the thrust below "
+        << 0.5 * holds << " N, ramp it in slowly, or raise EA";
+      return s.str();
+    }
   }
   const bool both = at.site[1] >= 0;
   // Positions now; velocities as the tether last saw them (a motion's exact velocity).
@@ -536,7 +547,7 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
     std::string message;
     std::optional<Tether> tether = Tether::Create(decl->params, env, &message);
     if (!tether) return fail(name, message);
-    if (!CheckParameters(decl->params, &message)) return fail(name, message);
+    if (!CheckParameters(decl->params, env.wet, &message)) return fail(name, message);
     std::string advice;
     if (!Advise(*tether, m->opt.timestep, &advice, &message)) return fail(name, message);
     if (!advice.empty()) {
