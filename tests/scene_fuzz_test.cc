@@ -34,6 +34,9 @@
 // seed, default 1), MJTETHER_SCENE_FUZZ_THREADS (default 2), MJTETHER_SCENE_FUZZ_VERBOSE=1
 // (one line per scene, flushed), MJTETHER_SCENE_FUZZ_XML=1 (print each scene's MJCF instead of
 // running it).
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -49,24 +52,21 @@
 #include <thread>
 #include <vector>
 
-#include <gtest/gtest.h>
-#include <mujoco/mujoco.h>
-
 #include "mjtether.h"
 
 namespace mjtether {
 namespace {
 
-constexpr double kStep = 0.002;     // [s] MuJoCo step of the scene
-constexpr double kDuration = 1.0;   // [s] simulated
-constexpr double kAverage = 0.2;    // [s] tension averaged over the last kAverage
+constexpr double kStep = 0.002;    // [s] MuJoCo step of the scene
+constexpr double kDuration = 1.0;  // [s] simulated
+constexpr double kAverage = 0.2;   // [s] tension averaged over the last kAverage
 // Explicit tethers substep at their stability limit, which for short stiff segments is a
 // microsecond: such a scene costs minutes per simulated second. Its duration is cut so that
 // it costs at most kBudget node updates (substeps x nodes x stages) per run, but not below
 // kMinDuration; the test counts the scenes run shortened.
 constexpr double kBudget = 2e7;
 constexpr double kMinDuration = 0.1;  // [s]
-constexpr double kRho = 1025;       // [kg/m^3]
+constexpr double kRho = 1025;         // [kg/m^3]
 constexpr double kPi = 3.14159265358979323846;
 
 struct Scene {
@@ -189,14 +189,15 @@ Scene Make(unsigned long long seed) {
   if (s.damping > 0) x << " damping=" << s.damping;
   x << "\"/>\n";
   if (s.motion_amp > 0) {
-    x << "<text name=\"motion:tms\" data=\"" << "xyz"[s.motion_axis] << "=" << s.motion_amp
-      << "," << s.motion_period << ",0\"/>\n";
+    x << "<text name=\"motion:tms\" data=\""
+      << "xyz"[s.motion_axis] << "=" << s.motion_amp << "," << s.motion_period << ",0\"/>\n";
   }
-  if (s.thrust > 0) x << "<text name=\"thrust:thr\" data=\"t=0.1,0.4 ctrl=0," << s.thrust << "\"/>\n";
+  if (s.thrust > 0)
+    x << "<text name=\"thrust:thr\" data=\"t=0.1,0.4 ctrl=0," << s.thrust << "\"/>\n";
   x << "</custom><worldbody>\n<body name=\"tms\" mocap=\"true\"><site name=\"tms_site\"/></body>\n"
     << "<body name=\"rov\" pos=\"" << s.b.x() << " " << s.b.y() << " " << s.b.z()
-    << "\"><freejoint/><inertial pos=\"0 0 0\" mass=\"" << s.mass << "\" diaginertia=\"" << I
-    << " " << I << " " << I << "\"/><site name=\"att\"/><site name=\"thr\"/></body>\n"
+    << "\"><freejoint/><inertial pos=\"0 0 0\" mass=\"" << s.mass << "\" diaginertia=\"" << I << " "
+    << I << " " << I << "\"/><site name=\"att\"/><site name=\"thr\"/></body>\n"
     << "</worldbody>";
   if (s.thrust > 0) {
     x << "<actuator><motor name=\"thr\" site=\"thr\" gear=\"" << s.thrust_dir.x() << " "
@@ -219,8 +220,8 @@ struct Run {
   bool loaded = false, diverged = false, finite = true;
   std::string error, message;
   Vec3 vehicle = Vec3::Zero(), tms = Vec3::Zero();  // [m] at the end (or at divergence)
-  double vehicle_speed = 0;                          // [m/s]
-  double tension = 0;                                // [N] mean over the last kAverage
+  double vehicle_speed = 0;                         // [m/s]
+  double tension = 0;                               // [N] mean over the last kAverage
   int warnings = 0;
   double duration = kDuration;  // [s] simulated
 };
@@ -372,8 +373,9 @@ Outcome JudgeRuns(const Scene& s) {
     if (Contains(msg, "Reduce <option timestep>") || Contains(msg, "stable step")) {
       const Run fine = Simulate(s, kStep / 10, coarse.duration);
       const bool ok = fine.loaded && !fine.diverged && fine.finite && fine.warnings == 0;
-      return {"diverged: step (10x smaller step runs)", ok,
-              msg + (ok ? "" : " | fine step: " + (fine.message.empty() ? fine.error : fine.message))};
+      return {
+          "diverged: step (10x smaller step runs)", ok,
+          msg + (ok ? "" : " | fine step: " + (fine.message.empty() ? fine.error : fine.message))};
     }
     return {"diverged: unrecognised cause", false, msg};
   }
@@ -443,10 +445,10 @@ TEST(SceneFuzz, EveryRandomSceneIsRefusedRunsCorrectlyOrDivergesWithACheckedCaus
       }
       const Outcome o = Judge(s);
       std::ostringstream line;
-      line << "seed " << s.seed << " [" << s.integrator << ", N=" << s.segments
-           << ", EA=" << s.EA << ", m=" << s.mass << " kg, omega*h=" << s.omega_h
-           << ", seabed kind " << s.seabed_kind << ", thrust/holds=" << s.thrust / s.holds()
-           << "]: " << (o.pass ? "pass" : "FAIL") << ": " << o.kind << ": " << o.detail;
+      line << "seed " << s.seed << " [" << s.integrator << ", N=" << s.segments << ", EA=" << s.EA
+           << ", m=" << s.mass << " kg, omega*h=" << s.omega_h << ", seabed kind " << s.seabed_kind
+           << ", thrust/holds=" << s.thrust / s.holds() << "]: " << (o.pass ? "pass" : "FAIL")
+           << ": " << o.kind << ": " << o.detail;
       std::lock_guard<std::mutex> lock(mutex);
       ++counts[(o.pass ? "pass  " : "FAIL  ") + o.kind];
       if (o.shortened) ++counts["(of these, run shortened below 1 s by the cost budget)"];
@@ -462,13 +464,14 @@ TEST(SceneFuzz, EveryRandomSceneIsRefusedRunsCorrectlyOrDivergesWithACheckedCaus
   for (std::thread& t : pool) t.join();
   mju_user_warning = previous;
 
-  std::printf("scene fuzzer: %zu scenes (seeds %ld..%ld plus %zu regression seeds)\n",
-              list.size(), first, first + count - 1, list.size() - static_cast<size_t>(count));
+  std::printf("scene fuzzer: %zu scenes (seeds %ld..%ld plus %zu regression seeds)\n", list.size(),
+              first, first + count - 1, list.size() - static_cast<size_t>(count));
   for (const auto& [kind, n] : counts) std::printf("  %5d  %s\n", n, kind.c_str());
   std::printf("known failures (tests/scene_fuzz_known.txt), run but not asserted: %zu\n",
               known_failures.size());
   for (const std::string& f : known_failures) std::printf("  known: %s\n", f.c_str());
-  for (const std::string& f : known_passing) std::printf("  known but now passing: %s\n", f.c_str());
+  for (const std::string& f : known_passing)
+    std::printf("  known but now passing: %s\n", f.c_str());
   for (const std::string& f : failures) ADD_FAILURE() << f;
   EXPECT_TRUE(failures.empty()) << failures.size() << " scenes failed";
 }

@@ -1,14 +1,14 @@
 // Honest start-up (issue 11, item 3): the initial shape lies on the seabed instead of below
 // it, scenes that cannot start are refused at load with their cause, a stretched start is
 // warned about with its strain and tension, and a divergence names its likely cause.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <string>
-#include <unistd.h>
-
-#include <gtest/gtest.h>
 
 #include "mujoco_fixture.h"
 
@@ -33,8 +33,8 @@ std::string SeabedXml(const std::string& integrator, double length, int segments
     << seabed << R"("/>
     <text name="tether:u" data="ends=tms,rov length=)"
     << length << " segments=" << segments
-    << R"( diameter=0.03 mass_per_length=1.0 EA=1e6 Cdn=1.2 Cdt=0.01 integrator=)"
-    << integrator << R"("/>
+    << R"( diameter=0.03 mass_per_length=1.0 EA=1e6 Cdn=1.2 Cdt=0.01 integrator=)" << integrator
+    << R"("/>
   </custom><worldbody>
     <site name="tms" pos=")"
     << a.x() << " " << a.y() << " " << a.z() << R"("/>
@@ -102,9 +102,9 @@ class StartUp : public MuJoCoFixture, public ::testing::WithParamInterface<const
 // integrator used to stop at t = 0.002 s.
 TEST_P(StartUp, LongTetherNearTheSeabedStartsOnItAndRuns) {
   const double seabed = -40;
-  mjModel* m = Load(SeabedXml(GetParam(), 100, 100, Vec3(0, 0, seabed + 3.5),
-                              Vec3(20, 0, seabed + 0.2), seabed),
-                    "case_one.xml");
+  mjModel* m = Load(
+      SeabedXml(GetParam(), 100, 100, Vec3(0, 0, seabed + 3.5), Vec3(20, 0, seabed + 0.2), seabed),
+      "case_one.xml");
   mjData* d = Make(m);
   const int grounded = CheckInitialShape(m, d, seabed);
   // Excess length on the seabed: L - (hA + hB + H) = 100 - 23.7 = 76.3 m at least lies flat
@@ -171,8 +171,7 @@ TEST(StartUpRefusal, EndsFartherApartThanLengthTimesOnePlusMaxStrainExitWith2) {
             2)
       << out;
   EXPECT_TRUE(Contains(out, "short.xml: <text name=\"tether:u\">: key 'length' = 10 m")) << out;
-  EXPECT_TRUE(Contains(out, "start 25 m apart, more than length x (1 + max_strain) = 20 m"))
-      << out;
+  EXPECT_TRUE(Contains(out, "start 25 m apart, more than length x (1 + max_strain) = 20 m")) << out;
 }
 
 TEST(StartUpRefusal, AnEndOrAVehicleBelowTheSeabedExitWith2) {
@@ -194,10 +193,10 @@ TEST(StartUpRefusal, AnEndOrAVehicleBelowTheSeabedExitWith2) {
 // 0.5 / (pi 8^2/4) = 0.0099 kg/m^3.
 TEST(StartUpRefusal, DiameterInMillimetresAndTooManySegmentsExitWith2) {
   std::string out;
-  EXPECT_EQ(RunCli(LineXml("length=30 segments=20 diameter=8 mass_per_length=0.5 EA=1e5",
-                           Vec3(20, 0, 0)),
-                   "mm.xml", &out),
-            2)
+  EXPECT_EQ(
+      RunCli(LineXml("length=30 segments=20 diameter=8 mass_per_length=0.5 EA=1e5", Vec3(20, 0, 0)),
+             "mm.xml", &out),
+      2)
       << out;
   EXPECT_TRUE(Contains(out, "key 'diameter' = 8 m with mass_per_length = 0.5 kg/m")) << out;
   EXPECT_TRUE(Contains(out, "give the diameter in metres")) << out;
