@@ -50,7 +50,8 @@ void Detach(const mjModel* m);
 
 // Warnings of the time-step advisor from Attach, one sentence each naming the file, the
 // tether, the explicit stability limit and the setting to change: an explicit tether whose
-// `substeps` or `max_step` makes its step longer than the limit. (Explicit tethers without
+// `substeps` or `max_step` makes its step longer than the limit; and a start stretched by
+// more than 0.1%, with its strain and tension. (Explicit tethers without
 // those keys substep automatically; more than 1e5 substeps per MuJoCo step is an error.)
 std::vector<std::string> Warnings(const mjModel* m);
 
@@ -82,8 +83,11 @@ void GetTensions(const mjModel* m, const mjData* d, int k, double* T);
 Vec3 ContactImpulse(const mjModel* m, const mjData* d, int k);
 int ContactDropped(const mjModel* m, const mjData* d, int k);
 
-// If a tether in d has diverged, a message naming the tether, the time and the node, and
-// what to change; the diverged tether stops applying forces. Otherwise nullopt.
+// If a tether in d has diverged, a message naming the tether, the time and the node, the
+// most likely cause when one can be checked (thrust beyond EA x max_strain, a snap load, ends
+// pulled apart by a motion or a body, an end too fast for the step, an end below the seabed,
+// a stretched start; README "Initial shape") and what to change; the diverged tether stops
+// applying forces. Otherwise nullopt.
 std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d);
 
 // Replaces MuJoCo's default error handler (which waits on stdin) by one that prints the

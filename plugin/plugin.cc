@@ -42,7 +42,9 @@ enum Slot : int {
   kContactDropped,   // candidates beyond capacity at the last advance
   kContactEndA,      // [N] (3) contact force on end node A (passed to its site), last advance
   kContactEndB = kContactEndA + 3,  // [N] (3) the same for end B
-  kHeader = kContactEndB + 3,  // x (3 x n) then v (3 x n) follow, then with contact `capacity` records
+  kStartTime = kContactEndB + 3,    // [s] when the initial shape was last set
+  kStartStrain,                     // [-] strain of the chord at that moment (0 when not stretched)
+  kHeader,  // x (3 x n) then v (3 x n) follow, then with contact `capacity` records
 };
 // A contact reaction record: body, force on it [N] (3), point of application [m] (3), applied
 // at every callback until the next advance replaces them.
@@ -73,6 +75,7 @@ struct ModelTethers {
   int work_size = 0;  // doubles of mjData stack the callback takes
   int nuserdata = 0;  // m->nuserdata after Attach, to catch a stale registration
   std::vector<std::string> warnings;  // time-step advisor (see Warnings in mjtether.h)
+  Environment env;                    // gravity and water, for the divergence diagnosis
 };
 
 // More automatic explicit substeps per MuJoCo step than this is refused at load time: the
@@ -187,6 +190,9 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
     // declared initial shape.
     tether.InitialShape(now, x, v);
     u[kInitialized] = 1;
+    u[kStartTime] = d->time;
+    u[kStartStrain] =
+        free_end ? 0 : std::max(0.0, (now.b.pos - now.a.pos).norm() / tether.params().length - 1);
     u[kTime] = u[kPrevTime] = d->time;
     StoreEnd(now.a, u + kEndA);
     StoreEnd(now.b, u + kEndB);
@@ -381,6 +387,229 @@ int FreeCarrier(const mjModel* m, int body) {
   return -1;
 }
 
+// Start-up checks at load time (README "Initial shape"). Thresholds:
+// - in water, a mean density mass_per_length / (pi d^2/4) below kMinDensity, that of air: no
+//   cable is lighter than air, while a diameter given in millimetres (the key's range stops at
+//   10 m, so 1-10 for 1-10 mm) gives 1e-3-1e-2 kg/m^3, a buoyancy 1e5-1e6 times the weight
+//   (dry, the diameter acts on nothing, and a near-massless dry line is a legitimate test);
+// - a diameter larger than the length: no longer a slender line (Morison drag per length,
+//   buoyancy of a cylinder);
+// - a rest segment length below kMinSegmentPerDiameter d: a cable cannot bend over less than
+//   several diameters (its minimum bend radius), so such nodes resolve nothing physical, and
+//   the lumped cylinder per node is wider than it is long (the hard-case suite checks d/5
+//   against Irvine's catenary; d/10 is the limit kept).
+constexpr double kMinDensity = 1.2;            // [kg/m^3] air
+constexpr double kMinSegmentPerDiameter = 0.1;  // [-] L0 / d
+// A start stretched beyond this strain is far from equilibrium: warned with its tension.
+constexpr double kStretchWarning = 1e-3;  // [-]
+
+bool CheckParameters(const TetherParams& p, bool wet, std::string* error) {
+  std::ostringstream s;
+  const double area = 3.14159265358979323846 * p.diameter * p.diameter / 4;
+  const double density = p.mass_per_length / area;
+  if (p.diameter > p.length) {
+    s << "key 'diameter' = " << p.diameter << " m is larger than the tether's length "
+      << p.length << " m: a lumped-mass line needs a slender tether (diameter in metres, not "
+      << "millimetres?)";
+  } else if (wet && density < kMinDensity) {
+    s << "key 'diameter' = " << p.diameter << " m with mass_per_length = " << p.mass_per_length
+      << " kg/m means a mean density of " << density << " kg/m^3, below " << kMinDensity
+      << " kg/m^3 (lighter than air; its buoyancy would be " << 1025 / density
+      << " times its weight in water): give the diameter in metres";
+  } else if (p.length / p.segments < kMinSegmentPerDiameter * p.diameter) {
+    s << "key 'segments' = " << p.segments << " makes segments of " << p.length / p.segments
+      << " m, shorter than " << kMinSegmentPerDiameter << " x the diameter " << p.diameter
+      << " m (a cable cannot bend over less than several diameters): use at most "
+      << static_cast<long long>(std::floor(p.length / (kMinSegmentPerDiameter * p.diameter)))
+      << " segments";
+  } else {
+    return true;
+  }
+  *error = s.str();
+  return false;
+}
+
+// The positions of the ends at the start (qpos0, mocap bodies at their model positions):
+// refuses an end below the seabed or ends farther apart than length (1 + max_strain); warns
+// about a stretched start with the strain and the tension it means.
+bool CheckStart(const mjModel* m, const mjData* d, const Environment& env,
+                const AttachedTether& at, std::string* warning, std::string* error) {
+  const TetherParams& p = at.tether.params();
+  const char* end_name[2] = {"A", "B"};
+  std::ostringstream s;
+  for (int end = 0; end < 2; ++end) {
+    if (at.site[end] < 0 || !env.water.has_seabed) continue;
+    const double z = d->site_xpos[3 * at.site[end] + 2];
+    if (z < env.water.seabed) {
+      s << "end " << end_name[end] << " (site '" << mj_id2name(m, mjOBJ_SITE, at.site[end])
+        << "') starts at z = " << z << " m, " << env.water.seabed - z
+        << " m below the seabed (water key 'seabed' = " << env.water.seabed
+        << " m): move the site or its body above the seabed, or lower the seabed";
+      *error = s.str();
+      return false;
+    }
+  }
+  if (at.site[1] < 0) return true;
+  const Vec3 a(d->site_xpos + 3 * at.site[0]), b(d->site_xpos + 3 * at.site[1]);
+  const double span = (b - a).norm(), strain = span / p.length - 1;
+  if (strain > p.max_strain) {
+    s << "key 'length' = " << p.length << " m: the ends (sites '"
+      << mj_id2name(m, mjOBJ_SITE, at.site[0]) << "', '" << mj_id2name(m, mjOBJ_SITE, at.site[1])
+      << "') start " << span << " m apart, more than length x (1 + max_strain) = "
+      << p.length * (1 + p.max_strain) << " m: the tether cannot start; make it at least "
+      << span << " m long or move the sites closer";
+    *error = s.str();
+    return false;
+  }
+  if (strain > kStretchWarning) {
+    s << "starts stretched, far from equilibrium: the ends are " << span
+      << " m apart for a length of " << p.length << " m, a strain of " << strain
+      << " and a tension EA x strain = " << p.EA * strain
+      << " N at the first step; make the tether at least " << span
+      << " m long unless a pre-tensioned start is meant";
+    *warning = s.str();
+  }
+  return true;
+}
+
+// Vehicles (vehicle:BODY texts) whose body starts below the seabed.
+bool CheckVehicles(const mjModel* m, const mjData* d, const Environment& env,
+                   std::string* element, std::string* error) {
+  if (!env.water.has_seabed) return true;
+  for (int i = 0; i < m->ntext; ++i) {
+    const std::string name = TextName(m, i);
+    if (name.rfind("vehicle:", 0) != 0) continue;
+    const int body = mj_name2id(m, mjOBJ_BODY, name.substr(8).c_str());
+    if (body < 0) continue;  // AttachVehicles reports it
+    const double z = d->xpos[3 * body + 2];
+    if (z < env.water.seabed) {
+      std::ostringstream s;
+      s << "body '" << name.substr(8) << "' starts at z = " << z << " m, "
+        << env.water.seabed - z << " m below the seabed (water key 'seabed' = "
+        << env.water.seabed << " m): move it above the seabed, or lower the seabed";
+      *element = name;
+      *error = s.str();
+      return false;
+    }
+  }
+  return true;
+}
+
+// The translational actuator force on the free-joint root of `body` [N] (0 if none).
+double ThrustOn(const mjModel* m, const mjData* d, int body) {
+  const int root = m->body_rootid[body];
+  const int j = m->body_jntadr[root];
+  if (j < 0 || m->jnt_type[j] != mjJNT_FREE) return 0;
+  const int dof = m->jnt_dofadr[j];
+  return Vec3(d->qfrc_actuator + dof).norm();
+}
+
+// The most likely cause of a divergence, from the state of the scene when it was reported,
+// with what to change; empty if none of the checkable causes applies (the step is then the
+// likely one). In order: thrust beyond what the tether holds, ends pulled apart beyond
+// length (1 + max_strain), an end moving more than half of max_strain L0 in one step, an end
+// below the seabed, a divergence within kStartSteps steps of a stretched start.
+std::string Diagnose(const mjModel* m, const mjData* d, const Environment& env,
+                     const AttachedTether& at, const double* u) {
+  constexpr int kStartSteps = 50;
+  const Tether& t = at.tether;
+  const TetherParams& p = t.params();
+  const double holds = p.EA * p.max_strain;  // [N] tension at max_strain
+  const char* end_name[2] = {"A", "B"};
+  std::ostringstream s;
+  auto body_name = [&](int end) {
+    const char* n = mj_id2name(m, mjOBJ_BODY, at.body[end]);
+    return std::string(n ? n : "world");
+  };
+  for (int end = 0; end < 2; ++end) {
+    if (at.site[end] < 0 || at.mocap[end] || at.body[end] <= 0) continue;
+    const double thrust = ThrustOn(m, d, at.body[end]);
+    if (thrust >= holds) {
+      s << "thrust beyond what the tether holds: the actuators push body '" << body_name(end)
+        << "' with " << thrust << " N, more than EA x max_strain = " << holds
+        << " N; reduce the thrust (or its schedule) below that, or raise EA";
+      return s.str();
+    }
+    // A load taken up suddenly (slack pulled taut, a thrust stepped on) overshoots its static
+    // strain up to twice (undamped spring under a step load).
+    if (thrust >= 0.5 * holds) {
+      s << "a snap load: the actuators push body '" << body_name(end) << "' with " << thrust
+        << " N, more than half of EA x max_strain = " << holds
+        << " N, and a load taken up suddenly overshoots its static strain up to twice; reduce "
+           "the thrust below "
+        << 0.5 * holds << " N, ramp it in slowly, or raise EA";
+      return s.str();
+    }
+  }
+  const bool both = at.site[1] >= 0;
+  // Positions now; velocities as the tether last saw them (a motion's exact velocity).
+  Vec3 pos[2], vel[2];
+  for (int end = 0; end < (both ? 2 : 1); ++end) {
+    pos[end] = Vec3(d->site_xpos + 3 * at.site[end]);
+    vel[end] = Vec3(u + (end == 0 ? kEndA : kEndB) + 3);
+  }
+  auto moved_by_motion = [&](int end) {
+    return at.mocap[end] && mj_name2id(m, mjOBJ_TEXT, ("motion:" + body_name(end)).c_str()) >= 0;
+  };
+  if (both && (pos[1] - pos[0]).norm() > p.length * (1 + p.max_strain)) {
+    s << "the ends were pulled " << (pos[1] - pos[0]).norm()
+      << " m apart, more than length x (1 + max_strain) = " << p.length * (1 + p.max_strain)
+      << " m";
+    for (int end = 0; end < 2; ++end) {
+      if (moved_by_motion(end)) {
+        s << ", by the prescribed motion of body '" << body_name(end)
+          << "'; reduce its amplitude (motion:" << body_name(end) << ") or lengthen the tether";
+        return s.str();
+      }
+    }
+    for (int end = 0; end < 2; ++end) {
+      if (at.body[end] > 0 && !at.mocap[end]) {
+        s << ", by forces on body '" << body_name(end) << "' larger than EA x max_strain = "
+          << holds << " N; lengthen the tether or reduce them";
+        return s.str();
+      }
+    }
+    s << ", by the motion of the ends' bodies; lengthen the tether or limit that motion";
+    return s.str();
+  }
+  const double h = m->opt.timestep;
+  for (int end = 0; end < (both ? 2 : 1); ++end) {
+    const double travel = vel[end].norm() * h;
+    if (travel > 0.5 * p.max_strain * t.rest_segment_length()) {
+      s << "end " << end_name[end] << " (body '" << body_name(end) << "') moves at "
+        << vel[end].norm() << " m/s, " << travel << " m per <option timestep> " << h
+        << " s, more than half of max_strain x the segment length "
+        << p.max_strain * t.rest_segment_length()
+        << " m: that motion is too fast for the step; reduce <option timestep> below "
+        << 0.5 * p.max_strain * t.rest_segment_length() / vel[end].norm()
+        << " s or slow the motion";
+      return s.str();
+    }
+  }
+  // An explicit tether forced (substeps, max_step) beyond its stability limit: the step.
+  if (IsExplicit(p.integrator) && h / t.SubstepsFor(h) > t.ExplicitStableStep()) return "";
+  if (env.water.has_seabed) {
+    for (int end = 0; end < (both ? 2 : 1); ++end) {
+      if (pos[end].z() < env.water.seabed) {
+        s << "seabed penetration: end " << end_name[end] << " (body '" << body_name(end)
+          << "') is " << env.water.seabed - pos[end].z()
+          << " m below the seabed (z = " << env.water.seabed
+          << " m), pressing the tether into it; keep the body above the seabed";
+        return s.str();
+      }
+    }
+  }
+  if (u[kStartStrain] > 0 && u[kBadTime] - u[kStartTime] <= kStartSteps * h * (1 + 1e-9)) {
+    s << "start-up strain: the tether started stretched by " << u[kStartStrain]
+      << " (tension EA x strain = " << p.EA * u[kStartStrain] << " N) and diverged "
+      << u[kBadTime] - u[kStartTime]
+      << " s later; make it at least as long as the distance between its ends ("
+      << p.length * (1 + u[kStartStrain]) << " m)";
+    return s.str();
+  }
+  return "";
+}
+
 }  // namespace
 
 void InstallErrorHandlers() {
@@ -419,6 +648,7 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
 
   auto set = std::make_unique<ModelTethers>();
   set->source = source;
+  set->env = env;
   int offset = m->nuserdata;
   for (int i = 0; i < m->ntext; ++i) {
     const std::string name = TextName(m, i);
@@ -430,6 +660,7 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
     std::string message;
     std::optional<Tether> tether = Tether::Create(decl->params, env, &message);
     if (!tether) return fail(name, message);
+    if (!CheckParameters(decl->params, env.wet, &message)) return fail(name, message);
     std::string advice;
     if (!Advise(*tether, m->opt.timestep, &advice, &message)) return fail(name, message);
     if (!advice.empty()) {
@@ -488,6 +719,28 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
     set->work_size =
         std::max(set->work_size, tether->WorkspaceSize() + ContactWorkSize(at));
     set->tethers.push_back(std::move(at));
+  }
+  // Start-up checks on the geometry at qpos0 (a scratch mjData, kinematics only).
+  if (!set->tethers.empty() || env.water.has_seabed) {
+    mjData* scratch = mj_makeData(m);
+    if (!scratch) return fail("", "cannot allocate mjData for the start-up checks");
+    mj_kinematics(m, scratch);
+    std::string message, element;
+    bool ok = true;
+    for (const AttachedTether& at : set->tethers) {
+      std::string warning;
+      if (!CheckStart(m, scratch, env, at, &warning, &message)) {
+        element = "tether:" + at.name;
+        ok = false;
+        break;
+      }
+      if (!warning.empty()) {
+        set->warnings.push_back(source + ": <text name=\"tether:" + at.name + "\">: " + warning);
+      }
+    }
+    if (ok) ok = CheckVehicles(m, scratch, env, &element, &message);
+    mj_deleteData(scratch);
+    if (!ok) return fail(element, message);
   }
   // Vehicles, motions and thrust schedules (plugin/vehicles.cc) use the same callback.
   bool vehicles = false;
@@ -661,7 +914,10 @@ std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d) {
           : u[kStatus] == 3 ? "kinetic energy blow-up"
                             : "non-finite position or velocity")
       << "). ";
-    if (IsExplicit(t.params().integrator)) {
+    const std::string cause = Diagnose(m, d, set->env, at, u);
+    if (!cause.empty()) {
+      s << "Most likely cause: " << cause << ".";
+    } else if (IsExplicit(t.params().integrator)) {
       s << "The " << IntegratorName(t.params().integrator) << " integrator's stable step is "
         << t.ExplicitStableStep()
         << " s; use integrator=implicit, or fewer segments (now " << t.segments()

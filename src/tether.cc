@@ -280,6 +280,7 @@ void Tether::InitialShape(const Ends& ends, double* xp, double* vp) const {
   if (p_.free_end) {
     Vec3 dir = env_.gravity.norm() > 0 ? down : ends.a.axis.normalized();
     for (int k = 0; k <= N_; ++k) x.col(k) = A + dir * (L * k / N_);
+    if (Has(kSeabed)) RestOnSeabed(ends, x);
     v.col(0) = ends.a.vel;
     return;
   }
@@ -374,8 +375,104 @@ void Tether::InitialShape(const Ends& ends, double* xp, double* vp) const {
     }
     x.col(N_) = B;  // remove round-off at the far end
   }
+  if (Has(kSeabed)) RestOnSeabed(ends, x);
   v.col(0) = ends.a.vel;
   v.col(N_) = ends.b.vel;
+}
+
+// A shape that dips below the seabed is replaced by one that lies on it: the line hangs from
+// each end as a catenary whose lowest point touches the seabed with a horizontal tangent, and
+// the length in between lies flat on the seabed along the ends' horizontal direction (the
+// grounded part carries the horizontal tension a w unchanged, without friction). For an end at height h above the seabed, a
+// catenary of parameter a (horizontal tension / weight per length) reaches the seabed after
+// arc length s = sqrt(h^2 + 2 a h) and horizontal distance x = a acosh(1 + h/a) (Irvine,
+// "Cable Structures", 1981, ch. 1); one a for both ends (the horizontal tension is continuous
+// through a frictionless grounded part) solves
+//   s_A(a) + s_B(a) + (H - x_A(a) - x_B(a)) = L,
+// whose left side falls monotonically from h_A + h_B + H (a -> 0) to H (a -> inf), by bisection
+// on log a. When even vertical drops leave length over (L > h_A + h_B + H), the ends hang
+// straight down and the rest lies on the seabed in a sideways U of the extra length. This
+// needs the net weight along -z (a horizontal seabed under ordinary gravity); otherwise (or
+// for an end below the seabed, which the MuJoCo glue refuses at load) the nodes are only
+// lifted onto the seabed. A free end hangs down to the seabed and lies along its site's axis.
+void Tether::RestOnSeabed(const Ends& ends, Nodes x) const {
+  const double zb = env_.water.seabed;
+  const double L = p_.length;
+  bool below = false;
+  for (int k = 0; k <= N_ && !below; ++k) below = x(2, k) < zb;
+  if (!below) return;
+  const Vec3 g = weight_.col(0).norm() > 0 ? Vec3(weight_.col(0)) : env_.gravity;
+  const bool vertical = g.norm() > 0 && -g.z() >= (1 - 1e-9) * g.norm();
+  const Vec3& A = ends.a.pos;
+  const Vec3 ez = Vec3::UnitZ();
+  const double hA = A.z() - zb;
+  // Horizontal direction of the grounded part: towards B, else along site A's axis, else x.
+  auto horizontal = [](const Vec3& d) {
+    const Vec3 hd(d.x(), d.y(), 0);
+    return hd.norm() > 1e-9 * std::max(1.0, d.norm()) ? Vec3(hd.normalized()) : Vec3::UnitX();
+  };
+  if (!vertical || hA < 0 || (!p_.free_end && ends.b.pos.z() < zb)) {
+    for (int k = 0; k <= N_; ++k) x(2, k) = std::max(x(2, k), zb);
+    return;
+  }
+  const Vec3 A0(A.x(), A.y(), zb);  // end A projected on the seabed
+  if (p_.free_end) {
+    const Vec3 eh = horizontal(ends.a.axis);
+    for (int k = 0; k <= N_; ++k) {
+      const double s = L * k / N_;
+      x.col(k) = s <= hA ? Vec3(A - s * ez) : Vec3(A0 + (s - hA) * eh);
+    }
+    return;
+  }
+  const Vec3& B = ends.b.pos;
+  const double hB = B.z() - zb;
+  const Vec3 B0(B.x(), B.y(), zb);
+  const double H = (B0 - A0).norm();
+  const Vec3 eh = H > 1e-9 * L ? Vec3((B0 - A0) / H) : horizontal(ends.a.axis);
+  const Vec3 en(-eh.y(), eh.x(), 0);  // horizontal normal: the side of the U
+  // Arc length s and horizontal reach x of one hanging part (h >= 0, a >= 0).
+  auto hang = [](double a, double h, double* s, double* xh) {
+    *s = std::sqrt(h * h + 2 * a * h);
+    *xh = a > 0 ? a * std::acosh(1 + h / a) : 0;
+  };
+  double a = 0, sA = hA, sB = hB, xA = 0, xB = 0, detour = 0;
+  if (L >= hA + hB + H) {
+    detour = 0.5 * (L - hA - hB - H);
+  } else {
+    double lo = std::log(1e-12 * L), hi = std::log(1e12 * L);
+    for (int it = 0; it < 200; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      hang(std::exp(mid), hA, &sA, &xA);
+      hang(std::exp(mid), hB, &sB, &xB);
+      (sA + sB + H - xA - xB > L ? lo : hi) = mid;
+    }
+    a = std::exp(0.5 * (lo + hi));
+    hang(a, hA, &sA, &xA);
+    hang(a, hB, &sB, &xB);
+  }
+  const double run = std::max(0.0, H - xA - xB);  // grounded length along eh
+  const Vec3 TA = A0 + xA * eh, TB = B0 - xB * eh;  // touchdown points
+  // A point of a hanging part at arc length sigma from its touchdown point T, going along dir.
+  auto hanging = [&](const Vec3& T, const Vec3& dir, double sigma) -> Vec3 {
+    const double u = a > 0 ? a * std::asinh(sigma / a) : 0;
+    return T + u * dir + (std::sqrt(a * a + sigma * sigma) - a) * ez;
+  };
+  for (int k = 1; k < N_; ++k) {
+    const double s = L * k / N_;
+    if (s <= sA) {
+      x.col(k) = hanging(TA, -eh, sA - s);
+    } else if (s >= L - sB) {
+      x.col(k) = hanging(TB, eh, s - (L - sB));
+    } else {
+      const double r = s - sA;  // along the grounded part: out by `detour`, along, back
+      x.col(k) = r < detour         ? Vec3(TA + r * en)
+                 : r < detour + run ? Vec3(TA + detour * en + (r - detour) * eh)
+                                    : Vec3(TA + (2 * detour + run - r) * en + run * eh);
+    }
+    x(2, k) = std::max(x(2, k), zb);  // round-off
+  }
+  x.col(0) = A;
+  x.col(N_) = B;
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -96,7 +96,9 @@ class Tether {
   // Initial shape: a straight line when the ends are at least `length` apart, otherwise an
   // inextensible catenary of the right length in the vertical plane through both ends (sagging
   // with the net weight); a free end hangs along gravity (or along site A's axis without
-  // gravity). Velocities: zero inside, the sites' at the ends.
+  // gravity). With the seabed effect, a shape that would dip below the seabed hangs from each
+  // end down to it and lays the rest of its length on it (see RestOnSeabed): no node starts
+  // below the seabed. Velocities: zero inside, the sites' at the ends.
   void InitialShape(const Ends& ends, double* x, double* v) const;
 
   // Advances the state by dt [s]; the attached ends move from `from` to `to` (cubic Hermite in
@@ -159,6 +161,8 @@ class Tether {
   void AddContact(ConstNodes x, ConstNodes v, const Ends& ends, Nodes f) const;
   void AccumulateContactImpulse(const double* x, const double* v, const Ends& ends, double weight,
                                 bool to_stage) const;
+
+  void RestOnSeabed(const Ends& ends, Nodes x) const;
 
   // Integrators (one step of size h; ends already set at the start, `next` at the end).
   void PlaceEnds(const Ends& e, Nodes x, Nodes v) const;

@@ -1,0 +1,480 @@
+// A scene fuzzer with physical oracles (issue 11, item 5; docs/scene_fuzzer.md).
+//
+// Each seed makes one random but plausible ROV scene: a TMS (mocap body, sometimes heaving or
+// surging by a motion: declaration) and a free vehicle of 2-5000 kg with its own vehicle:
+// hydrodynamics on a tether of 1-400 segments, EA 1e3-1e9 N, EI 0-1e3 N m^2, length 0.5-3 x
+// the span between them, in a current of 0-3 m/s, with a seabed below, through or above the
+// initial shape (or none), a thrust of 0-2 x what the tether holds (EA x max_strain), and one
+// of the four integrators, at a MuJoCo step of 2 ms for 1 s.
+//
+// Oracle. Every scene must end in one of these outcomes (the test prints how many of each):
+//   refused      refused at load (exit 2 from the CLI) with a cause this file recomputes from
+//                the scene (an end or the vehicle below the seabed, ends beyond
+//                length x (1 + max_strain), a diameter or segment count out of its threshold,
+//                more than 1e5 explicit substeps);
+//   agrees       runs to the end, every value finite, no MuJoCo warning, and agrees with the
+//                same scene at a 10x smaller MuJoCo step: vehicle position within
+//                max(5 cm, 2% of the span) and the vehicle-end tension averaged over the last
+//                0.2 s within max(0.5 N, 5%) (the issue's criterion for "silently wrong");
+//   diverged     stops with a divergence message whose cause this file checks: thrust beyond
+//                EA x max_strain, ends pulled beyond length x (1 + max_strain), an end moving
+//                more than half of max_strain L0 per step, an end below the seabed, a stretched
+//                start; or, where the message blames the step, the same scene at a 10x smaller
+//                step runs to the end.
+// Anything else is a failure: a refusal or divergence whose cause does not hold, a scene that
+// should have been refused, a non-finite value, a MuJoCo warning (it resets the data
+// silently), or a run that disagrees with its fine-step self.
+//
+// Seeds listed in tests/scene_fuzz_known.txt fail from the vehicle-tether coupling (omega h
+// >= 1 at the vehicle; fixed on another branch): they run and are counted, but not asserted.
+// Seeds in tests/scene_fuzz_regressions.txt are scenes that a long run once found broken;
+// they always run in addition to the fixed set.
+//
+// Environment: MJTETHER_SCENE_FUZZ_COUNT (default 200), MJTETHER_SCENE_FUZZ_FIRST (first
+// seed, default 1), MJTETHER_SCENE_FUZZ_THREADS (default 2), MJTETHER_SCENE_FUZZ_VERBOSE=1
+// (one line per scene, flushed), MJTETHER_SCENE_FUZZ_XML=1 (print each scene's MJCF instead of
+// running it).
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <random>
+#include <set>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "mjtether.h"
+
+namespace mjtether {
+namespace {
+
+constexpr double kStep = 0.002;    // [s] MuJoCo step of the scene
+constexpr double kDuration = 1.0;  // [s] simulated
+constexpr double kAverage = 0.2;   // [s] tension averaged over the last kAverage
+// Explicit tethers substep at their stability limit, which for short stiff segments is a
+// microsecond: such a scene costs minutes per simulated second. Its duration is cut so that
+// it costs at most kBudget node updates (substeps x nodes x stages) per run, but not below
+// kMinDuration; the test counts the scenes run shortened.
+constexpr double kBudget = 2e7;
+constexpr double kMinDuration = 0.1;  // [s]
+constexpr double kRho = 1025;         // [kg/m^3]
+constexpr double kPi = 3.14159265358979323846;
+
+struct Scene {
+  unsigned long long seed = 0;
+  std::string integrator;
+  double span = 0, length = 0;  // [m]
+  int segments = 0;
+  double diameter = 0, mpl = 0, EA = 0, EI = 0, damping = 0;
+  Vec3 b = Vec3::Zero();        // [m] vehicle (end B); end A at the origin
+  Vec3 current = Vec3::Zero();  // [m/s]
+  int seabed_kind = 0;          // 0 none, 1 below the shape, 2 through it, 3 above an end
+  double seabed = 0;            // [m]
+  double motion_amp = 0, motion_period = 1;  // [m], [s]; amp 0: no motion
+  int motion_axis = 0;
+  double mass = 0, added_min = 0;  // [kg] vehicle mass, smallest translational added mass
+  double thrust = 0;               // [N] final thrust
+  Vec3 thrust_dir = Vec3::UnitX();
+  double omega_h = 0;  // [-] coupling frequency at the vehicle times the step
+  std::string xml;
+
+  double holds() const { return EA * 1.0; }  // [N] EA x max_strain (default 1)
+  double L0() const { return length / segments; }
+};
+
+double LogUniform(std::mt19937_64& r, double lo, double hi) {
+  return std::exp(std::uniform_real_distribution<double>(std::log(lo), std::log(hi))(r));
+}
+double Uniform(std::mt19937_64& r, double lo, double hi) {
+  return std::uniform_real_distribution<double>(lo, hi)(r);
+}
+bool Chance(std::mt19937_64& r, double p) { return Uniform(r, 0, 1) < p; }
+
+// The lowest point of the initial shape without a seabed (the engine's own catenary).
+double LowestPoint(const Scene& s) {
+  TetherParams p;
+  p.length = s.length;
+  p.segments = s.segments;
+  p.diameter = s.diameter;
+  p.mass_per_length = s.mpl;
+  p.EA = s.EA;
+  p.effects = kAxial | kWeight | kBuoyancy;
+  Environment env;
+  env.wet = true;
+  std::string error;
+  std::optional<Tether> t = Tether::Create(p, env, &error);
+  if (!t) return 0;
+  std::vector<double> x(3 * t->nodes()), v(3 * t->nodes());
+  Ends ends;
+  ends.b.pos = s.b;
+  t->InitialShape(ends, x.data(), v.data());
+  double z = 0;
+  for (int i = 0; i < t->nodes(); ++i) z = std::min(z, x[3 * i + 2]);
+  return z;
+}
+
+Scene Make(unsigned long long seed) {
+  std::mt19937_64 r(seed * 0x9E3779B97F4A7C15ull + 12345);
+  Scene s;
+  s.seed = seed;
+  const char* integrators[4] = {"explicit", "implicit", "implicit2", "rk4"};
+  s.integrator = integrators[std::uniform_int_distribution<int>(0, 3)(r)];
+  s.span = LogUniform(r, 2, 200);
+  s.length = Uniform(r, 0.5, 3) * s.span;
+  s.segments = static_cast<int>(std::lround(LogUniform(r, 1, 400)));
+  s.diameter = LogUniform(r, 0.005, 0.05);
+  // Mean density 600-3000 kg/m^3: foam-jacketed umbilicals to steel-armoured cables.
+  s.mpl = Uniform(r, 600, 3000) * kPi * s.diameter * s.diameter / 4;
+  s.EA = LogUniform(r, 1e3, 1e9);
+  s.EI = Chance(r, 0.5) ? 0 : LogUniform(r, 1e-3, 1e3);
+  s.damping = Chance(r, 0.7) ? 0 : LogUniform(r, 1, 1e3);
+  // Vehicle: from the TMS down and out, elevation -80..+20 degrees.
+  const double az = Uniform(r, 0, 2 * kPi), el = Uniform(r, -80, 20) * kPi / 180;
+  s.b = s.span * Vec3(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+  if (Chance(r, 0.7)) {
+    const double c = Uniform(r, 0, 3), dir = Uniform(r, 0, 2 * kPi);
+    s.current = c * Vec3(std::cos(dir), std::sin(dir), 0);
+  }
+  const double top = std::min(0.0, s.b.z()), low = LowestPoint(s);
+  s.seabed_kind = std::uniform_int_distribution<int>(0, 3)(r);
+  if (s.seabed_kind == 2 && !(low < top - 0.01)) s.seabed_kind = 1;
+  if (s.seabed_kind == 1) s.seabed = std::min(low, top) - Uniform(r, 0.5, 20);
+  if (s.seabed_kind == 2) s.seabed = Uniform(r, low, top);
+  if (s.seabed_kind == 3) s.seabed = top + Uniform(r, 0.1, 5);
+  if (Chance(r, 0.3)) {
+    s.motion_amp = LogUniform(r, 0.05, 5);
+    s.motion_period = Uniform(r, 2, 10);
+    s.motion_axis = std::uniform_int_distribution<int>(0, 2)(r);
+  }
+  s.mass = LogUniform(r, 2, 5000);
+  const double side = std::cbrt(s.mass / 1000);  // [m] a box of the vehicle's mass in water
+  const double I = s.mass * side * side / 6;     // [kg m^2]
+  const double volume = s.mass / kRho * Uniform(r, 0.97, 1.03);
+  double added[3];
+  for (double& a : added) a = s.mass * Uniform(r, 0.3, 1.0);
+  s.added_min = std::min({added[0], added[1], added[2]});
+  const double lin = s.mass * Uniform(r, 0.2, 2), quad = 0.5 * kRho * side * side;
+  if (Chance(r, 0.6)) {
+    s.thrust = Uniform(r, 0, 2) * s.holds();
+    Vec3 dir = s.b.normalized() + 0.5 * Vec3(Uniform(r, -1, 1), Uniform(r, -1, 1), 0);
+    s.thrust_dir = dir.normalized();
+  }
+  const double m_eff = s.mass + s.added_min;
+  s.omega_h = std::sqrt(s.EA / (s.L0() * m_eff)) * kStep;
+
+  std::ostringstream x;
+  x.precision(10);
+  x << "<mujoco><option timestep=\"" << kStep << "\"/><custom>\n<text name=\"water\" data=\""
+    << "density=" << kRho;
+  if (s.current.norm() > 0) x << " current=" << s.current.x() << "," << s.current.y() << ",0";
+  if (s.seabed_kind != 0) x << " seabed=" << s.seabed;
+  x << "\"/>\n<text name=\"vehicle:rov\" data=\"volume=" << volume << " cob=0,0," << 0.1 * side
+    << " added_mass=" << added[0] << "," << added[1] << "," << added[2] << "," << 0.3 * I << ","
+    << 0.3 * I << "," << 0.3 * I << " linear_damping=" << lin << "," << lin << "," << lin << ","
+    << I << "," << I << "," << I << " quadratic_damping=" << quad << "," << quad << "," << quad
+    << "," << I << "," << I << "," << I << " coriolis=0\"/>\n"
+    << "<text name=\"tether:t\" data=\"ends=tms_site,att length=" << s.length
+    << " segments=" << s.segments << " diameter=" << s.diameter << " mass_per_length=" << s.mpl
+    << " EA=" << s.EA << " Cdn=1.2 Cdt=0.01 Can=1 integrator=" << s.integrator;
+  if (s.EI > 0) x << " EI=" << s.EI << " EAc=" << s.EA;
+  if (s.damping > 0) x << " damping=" << s.damping;
+  x << "\"/>\n";
+  if (s.motion_amp > 0) {
+    x << "<text name=\"motion:tms\" data=\""
+      << "xyz"[s.motion_axis] << "=" << s.motion_amp << "," << s.motion_period << ",0\"/>\n";
+  }
+  if (s.thrust > 0)
+    x << "<text name=\"thrust:thr\" data=\"t=0.1,0.4 ctrl=0," << s.thrust << "\"/>\n";
+  x << "</custom><worldbody>\n<body name=\"tms\" mocap=\"true\"><site name=\"tms_site\"/></body>\n"
+    << "<body name=\"rov\" pos=\"" << s.b.x() << " " << s.b.y() << " " << s.b.z()
+    << "\"><freejoint/><inertial pos=\"0 0 0\" mass=\"" << s.mass << "\" diaginertia=\"" << I << " "
+    << I << " " << I << "\"/><site name=\"att\"/><site name=\"thr\"/></body>\n"
+    << "</worldbody>";
+  if (s.thrust > 0) {
+    x << "<actuator><motor name=\"thr\" site=\"thr\" gear=\"" << s.thrust_dir.x() << " "
+      << s.thrust_dir.y() << " " << s.thrust_dir.z() << " 0 0 0\"/></actuator>";
+  }
+  x << "</mujoco>\n";
+  s.xml = x.str();
+  return s;
+}
+
+// MuJoCo warnings (e.g. a bad qacc, after which MuJoCo resets the data) are counted per thread.
+thread_local int t_warnings = 0;
+thread_local std::string t_last_warning;
+void CountWarning(const char* message) {
+  ++t_warnings;
+  t_last_warning = message;
+}
+
+struct Run {
+  bool loaded = false, diverged = false, finite = true;
+  std::string error, message;
+  Vec3 vehicle = Vec3::Zero(), tms = Vec3::Zero();  // [m] at the end (or at divergence)
+  double vehicle_speed = 0;                         // [m/s]
+  double tension = 0;                               // [N] mean over the last kAverage
+  int warnings = 0;
+  double duration = kDuration;  // [s] simulated
+};
+
+// The duration that keeps the scene within kBudget node updates at the step of 2 ms.
+double Duration(const mjModel* m) {
+  const Tether* t = GetTether(m, 0);
+  const int stages = t->params().integrator == Integrator::kRK4 ? 4 : 1;
+  const double per_second = double(t->SubstepsFor(kStep)) * t->nodes() * stages / kStep;
+  return std::clamp(kBudget / per_second, kMinDuration, kDuration);
+}
+
+Run Simulate(const Scene& s, double step, double duration = -1) {
+  Run run;
+  std::string xml = s.xml;
+  if (step != kStep) {
+    std::ostringstream opt;
+    opt << "timestep=\"" << step << "\"";
+    std::ostringstream old;
+    old << "timestep=\"" << kStep << "\"";
+    xml.replace(xml.find(old.str()), old.str().size(), opt.str());
+  }
+  mjModel* m = LoadModelFromString(xml, "scene" + std::to_string(s.seed) + ".xml", &run.error);
+  if (!m) return run;
+  run.loaded = true;
+  mjData* d = mj_makeData(m);
+  t_warnings = 0;
+  run.duration = duration > 0 ? duration : Duration(m);
+  const int steps = static_cast<int>(std::lround(run.duration / step));
+  const int average_from =
+      steps - static_cast<int>(std::lround(std::min(kAverage, run.duration / 5) / step));
+  double sum = 0;
+  int count = 0;
+  for (int k = 0; k < steps; ++k) {
+    Step(m, d);
+    if (std::optional<std::string> message = CheckDivergence(m, d)) {
+      run.diverged = true;
+      run.message = *message;
+      break;
+    }
+    if (k >= average_from) sum += GetReactions(m, d, 0).tension_b, ++count;
+    if (t_warnings > 0) break;
+  }
+  run.warnings = t_warnings;
+  if (t_warnings > 0) run.message = t_last_warning;
+  run.tension = count > 0 ? sum / count : 0;
+  const int rov = mj_name2id(m, mjOBJ_BODY, "rov"), tms = mj_name2id(m, mjOBJ_BODY, "tms");
+  run.vehicle = Vec3(d->xpos + 3 * rov);
+  run.tms = Vec3(d->xpos + 3 * tms);
+  run.vehicle_speed = Vec3(d->qvel).norm();
+  for (int i = 0; i < m->nq; ++i) run.finite = run.finite && std::isfinite(d->qpos[i]);
+  for (int i = 0; i < m->nv; ++i) run.finite = run.finite && std::isfinite(d->qvel[i]);
+  if (!run.diverged) {
+    const double* x = NodePositions(m, d, 0);
+    const int n = GetTether(m, 0)->nodes();
+    for (int i = 0; x && i < 3 * n; ++i) run.finite = run.finite && std::isfinite(x[i]);
+  }
+  mj_deleteData(d);
+  Detach(m);
+  mj_deleteModel(m);
+  return run;
+}
+
+bool Contains(const std::string& s, const std::string& part) {
+  return s.find(part) != std::string::npos;
+}
+
+// The outcome of one scene: a class name, pass or fail, and a one-line reason.
+struct Outcome {
+  std::string kind;
+  bool pass = false;
+  std::string detail;
+  bool shortened = false;  // run for less than kDuration (cost budget)
+};
+
+// Load refusals whose cause the scene itself confirms.
+Outcome CheckRefusal(const Scene& s, const std::string& error) {
+  const double span = s.b.norm();
+  const bool below = s.seabed_kind != 0 && (s.b.z() < s.seabed || 0 < s.seabed);
+  const double density = s.mpl / (kPi * s.diameter * s.diameter / 4);
+  if (Contains(error, "below the seabed")) {
+    return {"refused: below the seabed", below, error};
+  }
+  if (Contains(error, "more than length x (1 + max_strain)")) {
+    return {"refused: ends beyond length x (1 + max_strain)", span > s.length * 2, error};
+  }
+  if (Contains(error, "key 'segments'") && Contains(error, "x the diameter")) {
+    return {"refused: segments shorter than d/10", s.L0() < 0.1 * s.diameter, error};
+  }
+  if (Contains(error, "key 'diameter'")) {
+    return {"refused: diameter", s.diameter > s.length || density < 1.2, error};
+  }
+  if (Contains(error, "key 'ctrl'") && Contains(error, "[-1e+09, 1e+09]")) {
+    return {"refused: thrust schedule beyond its range (1e9 N)", s.thrust > 1e9, error};
+  }
+  if (Contains(error, "substeps per MuJoCo step")) {
+    return {"refused: explicit substeps > 1e5", s.integrator == "explicit" || s.integrator == "rk4",
+            error};
+  }
+  return {"refused: unrecognised cause", false, error};
+}
+
+// The refusals this file predicts from the scene (each must happen).
+std::string ExpectedRefusal(const Scene& s) {
+  if (s.seabed_kind == 3) return "an end below the seabed";
+  if (s.b.norm() > 2 * s.length) return "ends beyond length x (1 + max_strain)";
+  if (s.L0() < 0.1 * s.diameter) return "segments shorter than d/10";
+  return "";
+}
+
+thread_local bool t_shortened = false;
+
+Outcome JudgeRuns(const Scene& s) {
+  const Run coarse = Simulate(s, kStep);
+  t_shortened = coarse.loaded && coarse.duration < kDuration;
+  if (!coarse.loaded) return CheckRefusal(s, coarse.error);
+  if (const std::string expected = ExpectedRefusal(s); !expected.empty()) {
+    return {"not refused", false, "expected a refusal: " + expected};
+  }
+  if (coarse.warnings > 0) return {"MuJoCo warning", false, coarse.message};
+  if (!coarse.finite) return {"non-finite", false, "non-finite value without divergence report"};
+  if (coarse.diverged) {
+    const std::string& msg = coarse.message;
+    const double span = (coarse.vehicle - coarse.tms).norm();
+    const double fast = 0.5 * 1.0 * s.L0() / kStep;  // [m/s] speed the message refers to
+    const double tms_speed = 2 * kPi * s.motion_amp / s.motion_period;  // [m/s] upper bound
+    if (Contains(msg, "thrust beyond what the tether holds")) {
+      return {"diverged: thrust beyond EA x max_strain", s.thrust >= s.holds(), msg};
+    }
+    if (Contains(msg, "a snap load")) {
+      return {"diverged: snap load (thrust >= EA x max_strain / 2)", s.thrust >= 0.5 * s.holds(),
+              msg};
+    }
+    if (Contains(msg, "the ends were pulled")) {
+      return {"diverged: ends pulled apart", span > 2 * s.length, msg};
+    }
+    if (Contains(msg, "too fast for the step")) {
+      return {"diverged: end motion too fast for the step",
+              coarse.vehicle_speed > fast || tms_speed > fast, msg};
+    }
+    if (Contains(msg, "seabed penetration")) {
+      return {"diverged: seabed penetration",
+              s.seabed_kind != 0 && (coarse.vehicle.z() < s.seabed || coarse.tms.z() < s.seabed),
+              msg};
+    }
+    if (Contains(msg, "start-up strain")) {
+      return {"diverged: stretched start", s.b.norm() > s.length, msg};
+    }
+    if (Contains(msg, "Reduce <option timestep>") || Contains(msg, "stable step")) {
+      const Run fine = Simulate(s, kStep / 10, coarse.duration);
+      const bool ok = fine.loaded && !fine.diverged && fine.finite && fine.warnings == 0;
+      return {
+          "diverged: step (10x smaller step runs)", ok,
+          msg + (ok ? "" : " | fine step: " + (fine.message.empty() ? fine.error : fine.message))};
+    }
+    return {"diverged: unrecognised cause", false, msg};
+  }
+  const Run fine = Simulate(s, kStep / 10, coarse.duration);
+  if (!fine.loaded || fine.diverged || !fine.finite || fine.warnings > 0) {
+    return {"fine step failed", false, fine.message.empty() ? fine.error : fine.message};
+  }
+  const double dx = (coarse.vehicle - fine.vehicle).norm();
+  const double dT = std::abs(coarse.tension - fine.tension);
+  const double tol_x = std::max(0.05, 0.02 * s.span);
+  const double tol_T = std::max(0.5, 0.05 * std::max(coarse.tension, fine.tension));
+  std::ostringstream detail;
+  detail << "position " << dx << " m (tol " << tol_x << "), tension " << coarse.tension << " vs "
+         << fine.tension << " N (tol " << tol_T << ")";
+  if (dx > tol_x || dT > tol_T) return {"disagrees with 10x smaller step", false, detail.str()};
+  return {"agrees with 10x smaller step", true, detail.str()};
+}
+
+Outcome Judge(const Scene& s) {
+  t_shortened = false;
+  Outcome o = JudgeRuns(s);
+  o.shortened = t_shortened;
+  return o;
+}
+
+std::set<unsigned long long> ReadSeeds(const std::string& path) {
+  std::set<unsigned long long> seeds;
+  std::ifstream f(path);
+  std::string line;
+  while (std::getline(f, line)) {
+    std::istringstream l(line);
+    unsigned long long seed;
+    if (line.empty() || line[0] == '#' || !(l >> seed)) continue;
+    seeds.insert(seed);
+  }
+  return seeds;
+}
+
+long EnvLong(const char* name, long fallback) {
+  const char* v = std::getenv(name);
+  return v && *v ? std::strtol(v, nullptr, 10) : fallback;
+}
+
+TEST(SceneFuzz, EveryRandomSceneIsRefusedRunsCorrectlyOrDivergesWithACheckedCause) {
+  const long count = EnvLong("MJTETHER_SCENE_FUZZ_COUNT", 200);
+  const long first = EnvLong("MJTETHER_SCENE_FUZZ_FIRST", 1);
+  const long threads = std::max(1L, EnvLong("MJTETHER_SCENE_FUZZ_THREADS", 2));
+  const bool verbose = EnvLong("MJTETHER_SCENE_FUZZ_VERBOSE", 0) != 0;
+  const std::set<unsigned long long> known = ReadSeeds(MJTETHER_SCENE_FUZZ_KNOWN);
+  std::set<unsigned long long> seeds = ReadSeeds(MJTETHER_SCENE_FUZZ_REGRESSIONS);
+  for (long k = 0; k < count; ++k) seeds.insert(first + k);
+  const std::vector<unsigned long long> list(seeds.begin(), seeds.end());
+
+  void (*previous)(const char*) = mju_user_warning;
+  mju_user_warning = CountWarning;
+  std::mutex mutex;
+  std::map<std::string, int> counts;
+  std::vector<std::string> failures, known_failures, known_passing;
+  std::atomic<size_t> next{0};
+  auto worker = [&]() {
+    for (size_t i; (i = next++) < list.size();) {
+      const Scene s = Make(list[i]);
+      if (EnvLong("MJTETHER_SCENE_FUZZ_XML", 0) != 0) {
+        std::lock_guard<std::mutex> lock(mutex);
+        std::printf("seed %llu:\n%s", s.seed, s.xml.c_str());
+        continue;
+      }
+      const Outcome o = Judge(s);
+      std::ostringstream line;
+      line << "seed " << s.seed << " [" << s.integrator << ", N=" << s.segments << ", EA=" << s.EA
+           << ", m=" << s.mass << " kg, omega*h=" << s.omega_h << ", seabed kind " << s.seabed_kind
+           << ", thrust/holds=" << s.thrust / s.holds() << "]: " << (o.pass ? "pass" : "FAIL")
+           << ": " << o.kind << ": " << o.detail;
+      std::lock_guard<std::mutex> lock(mutex);
+      ++counts[(o.pass ? "pass  " : "FAIL  ") + o.kind];
+      if (o.shortened) ++counts["(of these, run shortened below 1 s by the cost budget)"];
+      const bool is_known = known.count(s.seed) > 0;
+      if (!o.pass && is_known) known_failures.push_back(line.str());
+      if (!o.pass && !is_known) failures.push_back(line.str());
+      if (o.pass && is_known) known_passing.push_back(line.str());
+      if (verbose) std::printf("%s\n", line.str().c_str()), std::fflush(stdout);
+    }
+  };
+  std::vector<std::thread> pool;
+  for (long t = 0; t < threads; ++t) pool.emplace_back(worker);
+  for (std::thread& t : pool) t.join();
+  mju_user_warning = previous;
+
+  std::printf("scene fuzzer: %zu scenes (seeds %ld..%ld plus %zu regression seeds)\n", list.size(),
+              first, first + count - 1, list.size() - static_cast<size_t>(count));
+  for (const auto& [kind, n] : counts) std::printf("  %5d  %s\n", n, kind.c_str());
+  std::printf("known failures (tests/scene_fuzz_known.txt), run but not asserted: %zu\n",
+              known_failures.size());
+  for (const std::string& f : known_failures) std::printf("  known: %s\n", f.c_str());
+  for (const std::string& f : known_passing)
+    std::printf("  known but now passing: %s\n", f.c_str());
+  for (const std::string& f : failures) ADD_FAILURE() << f;
+  EXPECT_TRUE(failures.empty()) << failures.size() << " scenes failed";
+}
+
+}  // namespace
+}  // namespace mjtether

@@ -1,0 +1,279 @@
+// Honest start-up (issue 11, item 3): the initial shape lies on the seabed instead of below
+// it, scenes that cannot start are refused at load with their cause, a stretched start is
+// warned about with its strain and tension, and a divergence names its likely cause.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "mujoco_fixture.h"
+
+namespace mjtether {
+namespace {
+
+using testing::MuJoCoFixture;
+
+bool Contains(const std::string& s, const std::string& part) {
+  return s.find(part) != std::string::npos;
+}
+
+const char* kIntegrators[] = {"implicit", "implicit2", "explicit", "rk4"};
+
+// A tether from a TMS site to an ROV site, both fixed in the world, in water with a seabed.
+std::string SeabedXml(const std::string& integrator, double length, int segments, const Vec3& a,
+                      const Vec3& b, double seabed) {
+  std::ostringstream s;
+  s.precision(12);
+  s << R"(<mujoco><option timestep="0.002"/><custom>
+    <text name="water" data="density=1025 seabed=)"
+    << seabed << R"("/>
+    <text name="tether:u" data="ends=tms,rov length=)"
+    << length << " segments=" << segments
+    << R"( diameter=0.03 mass_per_length=1.0 EA=1e6 Cdn=1.2 Cdt=0.01 integrator=)" << integrator
+    << R"("/>
+  </custom><worldbody>
+    <site name="tms" pos=")"
+    << a.x() << " " << a.y() << " " << a.z() << R"("/>
+    <site name="rov" pos=")"
+    << b.x() << " " << b.y() << " " << b.z() << R"("/>
+  </worldbody></mujoco>)";
+  return s.str();
+}
+
+// Net weight per length of the tether above [N/m]: (mu - rho pi d^2/4) g.
+constexpr double kWet = (1.0 - 1025 * 3.14159265358979323846 * 0.03 * 0.03 / 4) * 9.81;
+
+class StartUp : public MuJoCoFixture, public ::testing::WithParamInterface<const char*> {
+ protected:
+  // Loads the scene, checks the initial shape (no node below the seabed, every segment at most
+  // L0 long, total chord length within 1% of L: the shape is the declared tether, not a
+  // stretched or shortened one) and returns the number of nodes resting on the seabed.
+  int CheckInitialShape(mjModel* m, mjData* d, double seabed) {
+    mj_forward(m, d);
+    const Tether* t = GetTether(m, 0);
+    const double* x = NodePositions(m, d, 0);
+    const double L0 = t->rest_segment_length();
+    double total = 0;
+    int grounded = 0;
+    for (int i = 0; i < t->nodes(); ++i) {
+      // 1e-9 m: the seabed height goes through the XML text (12 digits).
+      EXPECT_GE(x[3 * i + 2], seabed - 1e-9) << "node " << i << " starts below the seabed";
+      if (x[3 * i + 2] < seabed + 1e-9) ++grounded;
+      if (i == 0) continue;
+      const double l = std::hypot(std::hypot(x[3 * i] - x[3 * i - 3], x[3 * i + 1] - x[3 * i - 2]),
+                                  x[3 * i + 2] - x[3 * i - 1]);
+      EXPECT_LE(l, L0 * (1 + 1e-9)) << "segment " << i - 1 << " starts stretched";
+      total += l;
+    }
+    // Chords of a curved line are shorter than its arcs by ~L0^2 kappa^2/24 each; 1% is far
+    // above that for these shapes and far below a shape that dropped length.
+    EXPECT_NEAR(total, t->params().length, 0.01 * t->params().length);
+    return grounded;
+  }
+
+  // Runs `seconds` and checks: no divergence, and no node deeper in the seabed than 20 times
+  // the static penetration of a resting line, w/k = 27 um (README, seabed slam: rests at
+  // seabed - w/k). A grounded node starts at zero penetration, so it sinks to w/k (case one:
+  // measured exactly w/k); where long steep hanging parts meet the seabed (case two), their
+  // settling onto the discrete equilibrium presses the touchdown region 7-13 w/k deep during
+  // the first second. The old start put nodes 4 m and 45 m deep.
+  void RunAndCheckPenetration(mjModel* m, mjData* d, double seabed, double seconds) {
+    const double allowed = 20 * kWet / 1e5;  // [m] k = 1e5 N/m^2 (default seabed_stiffness)
+    const Tether* t = GetTether(m, 0);
+    double deepest = 0;
+    while (d->time < seconds) {
+      mj_step(m, d);
+      std::optional<std::string> message = CheckDivergence(m, d);
+      ASSERT_FALSE(message) << *message;
+      const double* x = NodePositions(m, d, 0);
+      for (int i = 0; i < t->nodes(); ++i) deepest = std::max(deepest, seabed - x[3 * i + 2]);
+    }
+    std::printf("%s: deepest penetration %.3g m (allowed %.3g m)\n", GetParam(), deepest, allowed);
+    EXPECT_LE(deepest, allowed);
+  }
+};
+
+// Issue 11, case one: 100 m, 100 segments, TMS 3.5 m above a seabed at -40 m, ROV 20 m away
+// just above the seabed. The catenary of 100 m would hang ~45 m into the seabed; every
+// integrator used to stop at t = 0.002 s.
+TEST_P(StartUp, LongTetherNearTheSeabedStartsOnItAndRuns) {
+  const double seabed = -40;
+  mjModel* m = Load(
+      SeabedXml(GetParam(), 100, 100, Vec3(0, 0, seabed + 3.5), Vec3(20, 0, seabed + 0.2), seabed),
+      "case_one.xml");
+  mjData* d = Make(m);
+  const int grounded = CheckInitialShape(m, d, seabed);
+  // Excess length on the seabed: L - (hA + hB + H) = 100 - 23.7 = 76.3 m at least lies flat
+  // (76 nodes of 1 m); the hanging parts add a little more.
+  EXPECT_GE(grounded, 76);
+  RunAndCheckPenetration(m, d, seabed, 2.0);
+}
+
+// Issue 11, case two: a seabed that the initial catenary crosses by 4 m (60 m, span 15 m).
+TEST_P(StartUp, SeabedThroughTheCatenaryStartsOnItAndRuns) {
+  const Vec3 a(0, 0, 0), b(15, 0, 0);
+  // The lowest point of the catenary without a seabed, from the engine's own initial shape.
+  double low = 0;
+  {
+    mjModel* m0 = Load(SeabedXml(GetParam(), 60, 60, a, b, -1000), "no_seabed.xml");
+    mjData* d0 = Make(m0);
+    mj_forward(m0, d0);
+    const double* x = NodePositions(m0, d0, 0);
+    for (int i = 0; i <= 60; ++i) low = std::min(low, x[3 * i + 2]);
+  }
+  const double seabed = low + 4;
+  mjModel* m = Load(SeabedXml(GetParam(), 60, 60, a, b, seabed), "case_two.xml");
+  mjData* d = Make(m);
+  EXPECT_GE(CheckInitialShape(m, d, seabed), 2);
+  RunAndCheckPenetration(m, d, seabed, 2.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Integrators, StartUp, ::testing::ValuesIn(kIntegrators));
+
+// ---------------------------------------------------------------------------------------------
+// Refused at load (CLI exit code 2, cause named) and warned about.
+
+int RunCli(const std::string& xml, const std::string& name, std::string* output) {
+  const std::string dir = ::testing::TempDir() + "/startup_" + std::to_string(getpid());
+  std::system(("mkdir -p " + dir).c_str());
+  const std::string path = dir + "/" + name, out = dir + "/" + name + ".out";
+  std::ofstream(path) << xml;
+  const int status = std::system(
+      (std::string(MJTETHER_CLI) + " run " + path + " --duration 0.1 > " + out + " 2>&1").c_str());
+  std::ifstream f(out);
+  std::stringstream s;
+  s << f.rdbuf();
+  *output = s.str();
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string LineXml(const std::string& tether_keys, const Vec3& b, const std::string& water = "") {
+  std::ostringstream s;
+  s << R"(<mujoco><option timestep="0.002"/><custom>
+    <text name="water" data="density=1025 )"
+    << water << R"("/>
+    <text name="tether:u" data="ends=a,b )"
+    << tether_keys << R"("/></custom><worldbody><site name="a"/>
+    <site name="b" pos=")"
+    << b.x() << " " << b.y() << " " << b.z() << R"("/></worldbody></mujoco>)";
+  return s.str();
+}
+
+const char* kLine = "segments=20 diameter=0.02 mass_per_length=0.5 EA=1e5 Cdn=1.2";
+
+TEST(StartUpRefusal, EndsFartherApartThanLengthTimesOnePlusMaxStrainExitWith2) {
+  std::string out;
+  EXPECT_EQ(RunCli(LineXml(std::string("length=10 ") + kLine, Vec3(25, 0, 0)), "short.xml", &out),
+            2)
+      << out;
+  EXPECT_TRUE(Contains(out, "short.xml: <text name=\"tether:u\">: key 'length' = 10 m")) << out;
+  EXPECT_TRUE(Contains(out, "start 25 m apart, more than length x (1 + max_strain) = 20 m")) << out;
+}
+
+TEST(StartUpRefusal, AnEndOrAVehicleBelowTheSeabedExitWith2) {
+  std::string out;
+  EXPECT_EQ(RunCli(LineXml(std::string("length=30 ") + kLine, Vec3(20, 0, -10), "seabed=-5"),
+                   "end_below.xml", &out),
+            2)
+      << out;
+  EXPECT_TRUE(Contains(out, "end B (site 'b') starts at z = -10 m, 5 m below the seabed")) << out;
+  const std::string vehicle = R"(<mujoco><option timestep="0.002"/><custom>
+    <text name="water" data="seabed=-5"/><text name="vehicle:rov" data="volume=0.01"/>
+    </custom><worldbody><body name="rov" pos="0 0 -6"><freejoint/>
+    <geom type="sphere" size="0.2" mass="10"/></body></worldbody></mujoco>)";
+  EXPECT_EQ(RunCli(vehicle, "vehicle_below.xml", &out), 2) << out;
+  EXPECT_TRUE(Contains(out, "<text name=\"vehicle:rov\">: body 'rov' starts at z = -6 m")) << out;
+}
+
+// A diameter in millimetres (8 for 8 mm; the parser's range stops at 10 m): mean density
+// 0.5 / (pi 8^2/4) = 0.0099 kg/m^3.
+TEST(StartUpRefusal, DiameterInMillimetresAndTooManySegmentsExitWith2) {
+  std::string out;
+  EXPECT_EQ(
+      RunCli(LineXml("length=30 segments=20 diameter=8 mass_per_length=0.5 EA=1e5", Vec3(20, 0, 0)),
+             "mm.xml", &out),
+      2)
+      << out;
+  EXPECT_TRUE(Contains(out, "key 'diameter' = 8 m with mass_per_length = 0.5 kg/m")) << out;
+  EXPECT_TRUE(Contains(out, "give the diameter in metres")) << out;
+  // 1 m in 1000 segments of 1 mm with a 2 cm diameter: L0 = d/20.
+  EXPECT_EQ(RunCli(LineXml("length=1 segments=1000 diameter=0.02 mass_per_length=0.5 EA=1e5",
+                           Vec3(0.9, 0, 0)),
+                   "many.xml", &out),
+            2)
+      << out;
+  EXPECT_TRUE(Contains(out, "key 'segments' = 1000 makes segments of 0.001 m")) << out;
+  EXPECT_TRUE(Contains(out, "use at most 500 segments")) << out;
+}
+
+// A start stretched by 2%: the run goes on, with a warning giving the strain and EA x strain.
+TEST(StartUpWarning, StretchedStartIsWarnedWithStrainAndTension) {
+  std::string out;
+  EXPECT_EQ(RunCli(LineXml(std::string("length=10 ") + kLine, Vec3(10.2, 0, 0)), "taut.xml", &out),
+            0)
+      << out;
+  EXPECT_TRUE(Contains(out, "mjtether: warning: ")) << out;
+  EXPECT_TRUE(Contains(out, "starts stretched, far from equilibrium")) << out;
+  EXPECT_TRUE(Contains(out, "a strain of 0.02 and a tension EA x strain = 2000 N")) << out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// A divergence names its likely cause instead of "reduce the time step".
+
+class StartUpDivergence : public MuJoCoFixture {
+ protected:
+  std::string RunUntilDivergence(const std::string& xml, double seconds) {
+    mjModel* m = Load(xml, "scene.xml");
+    mjData* d = Make(m);
+    while (d->time < seconds) {
+      Step(m, d);
+      if (std::optional<std::string> message = CheckDivergence(m, d)) return *message;
+    }
+    return "";
+  }
+};
+
+// A vehicle on a 20 m tether (EA = 1e6 N, so EA x max_strain = 1e6 N) pushed by 1e7 N.
+TEST_F(StartUpDivergence, ThrustBeyondWhatTheTetherHoldsIsNamed) {
+  const std::string xml = R"(<mujoco><option timestep="0.002"/><custom>
+    <text name="water" data="density=1025"/>
+    <text name="vehicle:rov" data="volume=0.1 added_mass=50,50,50,1,1,1
+          linear_damping=50,50,50,5,5,5"/>
+    <text name="tether:u" data="ends=tms,att length=20 segments=20 diameter=0.02
+          mass_per_length=0.5 EA=1e6 Cdn=1.2 integrator=implicit"/>
+    <text name="thrust:thr" data="t=0,0.1 ctrl=0,1e7"/>
+  </custom><worldbody><site name="tms"/>
+    <body name="rov" pos="15 0 0"><freejoint/><inertial pos="0 0 0" mass="100"
+      diaginertia="5 5 5"/><site name="att"/><site name="thr"/></body>
+  </worldbody><actuator><motor name="thr" site="thr" gear="1 0 0 0 0 0"/></actuator></mujoco>)";
+  const std::string message = RunUntilDivergence(xml, 2);
+  ASSERT_FALSE(message.empty()) << "no divergence";
+  EXPECT_TRUE(Contains(message, "thrust beyond what the tether holds")) << message;
+  EXPECT_TRUE(Contains(message, "body 'rov'")) << message;
+  EXPECT_TRUE(Contains(message, "EA x max_strain = 1e+06 N")) << message;
+  EXPECT_FALSE(Contains(message, "Reduce <option timestep>")) << message;
+}
+
+// A TMS heaving with a 1000 m amplitude on a 20 m tether to a fixed site.
+TEST_F(StartUpDivergence, HugePrescribedMotionIsNamed) {
+  const std::string xml = R"(<mujoco><option timestep="0.002"/><custom>
+    <text name="water" data="density=1025"/>
+    <text name="tether:u" data="ends=tms_site,b length=20 segments=20 diameter=0.02
+          mass_per_length=0.5 EA=1e6 Cdn=1.2 integrator=implicit"/>
+    <text name="motion:tms" data="x=1000,10,0 ramp=1"/>
+  </custom><worldbody><body name="tms" mocap="true"><site name="tms_site"/></body>
+    <site name="b" pos="15 0 0"/></worldbody></mujoco>)";
+  const std::string message = RunUntilDivergence(xml, 5);
+  ASSERT_FALSE(message.empty()) << "no divergence";
+  EXPECT_TRUE(Contains(message, "body 'tms'")) << message;
+  EXPECT_TRUE(Contains(message, "prescribed motion") || Contains(message, "too fast for the step"))
+      << message;
+  EXPECT_FALSE(Contains(message, "Reduce <option timestep> (now")) << message;
+}
+
+}  // namespace
+}  // namespace mjtether
