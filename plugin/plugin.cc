@@ -452,6 +452,13 @@ bool CheckStart(const mjModel* m, const mjData* d, const Environment& env,
   if (at.site[1] < 0) return true;
   const Vec3 a(d->site_xpos + 3 * at.site[0]), b(d->site_xpos + 3 * at.site[1]);
   const double span = (b - a).norm(), strain = span / p.length - 1;
+  if (!std::isfinite(span)) {
+    s << "the end sites ('" << mj_id2name(m, mjOBJ_SITE, at.site[0]) << "', '"
+      << mj_id2name(m, mjOBJ_SITE, at.site[1])
+      << "') start at positions that are not finite: check the pos and quat of their bodies";
+    *error = s.str();
+    return false;
+  }
   if (strain > p.max_strain) {
     s << "key 'length' = " << p.length << " m: the ends (sites '"
       << mj_id2name(m, mjOBJ_SITE, at.site[0]) << "', '" << mj_id2name(m, mjOBJ_SITE, at.site[1])

@@ -43,7 +43,7 @@ REPO = pathlib.Path(__file__).resolve().parent.parent
 # The fast suite: every CTest test but the labels valgrind (minutes per test) and long (the
 # hour-long runs), and but the renderer's tests (pixels and videos; no catalogue entry touches
 # the renderer, and they take a third of the suite's time).
-FAST_EXCLUDE_LABELS = "valgrind|long"
+FAST_EXCLUDE_LABELS = "valgrind|long|scene_fuzz"  # scene_fuzz: 80+ s, physics covered elsewhere
 FAST_EXCLUDE_NAMES = "^Render"
 TEST_TIMEOUT = 300  # [s] per test; a mutant that makes a test hang is caught by the timeout
 
