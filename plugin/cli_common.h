@@ -260,6 +260,18 @@ class OutputGuard {
   std::vector<Entry> files_;
 };
 
+// The checks every output makes before it is opened: not a directory, and claimed in the
+// guard (not an input, not another output).
+inline bool ClaimTarget(const std::string& target, const std::string& option, OutputGuard* guard,
+                        std::string* error) {
+  struct stat st {};
+  if (stat(target.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
+    *error = option + " " + target + " is a directory";
+    return false;
+  }
+  return guard->Claim(target, option, error);
+}
+
 // A CSV (or any text) output: written to a temporary file beside its target and renamed into
 // place by Commit. Rows are buffered whole and written whole; after a failed write the file is
 // cut back to the last complete row. A target that is not a regular file (/dev/null, /dev/full,
@@ -276,12 +288,8 @@ class OutputFile {
             std::string* error) {
     target_ = target;
     option_ = option;
+    if (!ClaimTarget(target, option, guard, error)) return false;
     struct stat st {};
-    if (stat(target.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
-      *error = option + " " + target + " is a directory";
-      return false;
-    }
-    if (!guard->Claim(target, option, error)) return false;
     if (stat(target.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
       fd_ = open(target.c_str(), O_WRONLY | O_CLOEXEC);
       direct_ = true;
@@ -396,12 +404,7 @@ class ToolOutput {
             std::string* error) {
     target_ = target;
     option_ = option;
-    struct stat st {};
-    if (stat(target.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
-      *error = option + " " + target + " is a directory";
-      return false;
-    }
-    if (!guard->Claim(target, option, error)) return false;
+    if (!ClaimTarget(target, option, guard, error)) return false;
     const std::string leaf = LeafOf(target);
     const size_t dot = leaf.find_last_of('.');
     const std::string ext = dot == std::string::npos || dot == 0 ? "" : leaf.substr(dot);
