@@ -103,9 +103,13 @@ void RolloutPool::One(mjData* d, int i) {
     }
     const size_t row = size_t(i) * r.steps + s;
     r.time[row] = d->time;
-    std::memcpy(&r.qpos[row * r.nq], d->qpos, sizeof(double) * r.nq);
-    std::memcpy(&r.qvel[row * r.nv], d->qvel, sizeof(double) * r.nv);
-    std::memcpy(&r.sensordata[row * r.nsensordata], d->sensordata, sizeof(double) * r.nsensordata);
+    // Pointer arithmetic on data(), not &v[k]: a model without sensors has an empty
+    // sensordata vector, and v[0] of an empty vector is undefined (UBSan reports it).
+    std::memcpy(r.qpos.data() + row * r.nq, d->qpos, sizeof(double) * r.nq);
+    std::memcpy(r.qvel.data() + row * r.nv, d->qvel, sizeof(double) * r.nv);
+    if (r.nsensordata > 0)
+      std::memcpy(r.sensordata.data() + row * r.nsensordata, d->sensordata,
+                  sizeof(double) * r.nsensordata);
     for (int k = 0; k < r.ntether; ++k) {
       const EndReactions e = GetReactions(m, d, k);
       r.tension[(row * r.ntether + k) * 2] = e.tension_a;

@@ -58,10 +58,11 @@ struct Rollouts {
   std::vector<std::string> message;  // n; empty when the rollout ran all its steps
 
   // Rollout i after step s + 1.
-  const double* Qpos(int i, int s) const { return &qpos[(size_t(i) * steps + s) * nq]; }
-  const double* Qvel(int i, int s) const { return &qvel[(size_t(i) * steps + s) * nv]; }
+  // (data() + offset, not &v[k]: a vector is empty when the model has no sensors.)
+  const double* Qpos(int i, int s) const { return qpos.data() + (size_t(i) * steps + s) * nq; }
+  const double* Qvel(int i, int s) const { return qvel.data() + (size_t(i) * steps + s) * nv; }
   const double* Sensordata(int i, int s) const {
-    return &sensordata[(size_t(i) * steps + s) * nsensordata];
+    return sensordata.data() + (size_t(i) * steps + s) * nsensordata;
   }
   // Tension [N] of tether k at end 0 (A) or 1 (B).
   double Tension(int i, int s, int k, int end) const {
