@@ -24,7 +24,7 @@
 #include <string>
 #include <vector>
 
-#include "cli_step.h"  // StepAndCheck: the checks `mjtether run` makes after each step
+#include "step_check.h"  // StepAndCheck: the checks `mjtether run` makes after each step
 
 namespace py = pybind11;
 

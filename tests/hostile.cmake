@@ -10,7 +10,7 @@ gtest_discover_tests(hostile_test DISCOVERY_TIMEOUT 60 PROPERTIES LABELS hostile
 
 add_executable(observe_test observe_test.cc)
 target_link_libraries(observe_test PRIVATE mjtether_plugin GTest::gtest_main)
-target_include_directories(observe_test PRIVATE ${CLI11_INCLUDE_DIR})
+target_include_directories(observe_test PRIVATE ${PROJECT_SOURCE_DIR}/cli ${CLI11_INCLUDE_DIR})
 target_compile_definitions(observe_test PRIVATE
   MJTETHER_HOSTILE_DIR="${CMAKE_CURRENT_SOURCE_DIR}/hostile"
   MJTETHER_CLI="$<TARGET_FILE:mjtether>")

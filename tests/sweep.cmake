@@ -4,7 +4,7 @@
 # (tools/sweep_slurm_check.sh), not here: it needs root and daemons.
 add_executable(sweep_test sweep_test.cc)
 target_link_libraries(sweep_test PRIVATE mjtether_plugin GTest::gtest_main)
-target_include_directories(sweep_test PRIVATE ${PROJECT_SOURCE_DIR}/plugin)
+target_include_directories(sweep_test PRIVATE ${PROJECT_SOURCE_DIR}/cli)
 target_compile_definitions(sweep_test PRIVATE
   MJTETHER_MODELS_DIR="${PROJECT_SOURCE_DIR}/models"
   MJTETHER_CLI="$<TARGET_FILE:mjtether>")

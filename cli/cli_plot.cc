@@ -23,7 +23,7 @@
 #include "cli_common.h"
 #include "cli_pipe.h"
 #include "cli_plot_columns.h"
-#include "cli_step.h"
+#include "step_check.h"
 #include "mjtether.h"
 #include "render.h"
 

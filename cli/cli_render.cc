@@ -27,7 +27,7 @@
 #include "cli_command.h"
 #include "cli_common.h"
 #include "cli_pipe.h"
-#include "cli_step.h"
+#include "step_check.h"
 #include "mjtether.h"
 #include "render.h"
 

@@ -15,7 +15,7 @@
 #include "cli_command.h"
 #include "cli_common.h"
 #include "cli_run_summary.h"
-#include "cli_step.h"
+#include "step_check.h"
 #include "declaration.h"
 #include "mjtether.h"
 #include "overrides.h"

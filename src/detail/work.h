@@ -1,0 +1,81 @@
+// Internal to the engine (not installed): the tuning constants and the scratch layout that the
+// force terms (forces.cc) and the integrators (integrators.cc) share.
+#pragma once
+
+#include "block_band.h"
+
+namespace mjtether {
+namespace detail {
+
+constexpr double kPi = 3.14159265358979323846;
+// A segment shorter than this fraction of its rest length has no direction: it carries no
+// tension, no bending shear and no tangent (coincident nodes must not produce NaN).
+constexpr double kMinLengthRatio = 1e-9;
+// Fraction of the explicit stability limit actually used (the estimate ignores drag and the
+// geometric stiffness T/l, both small against EA/L0 in practice).
+constexpr double kExplicitSafety = 0.8;
+// An implicit step whose linearisation missed more tension than this fraction of the largest
+// (from segments turning within the step) iterates again (see ImplicitStep).
+constexpr double kLinearisationTolerance = 0.01;
+// Where the implicit step's law changed within it, its Newton iteration goes on until every
+// node's velocity error |G_i|/m_i is below this fraction of the step's largest velocity change
+// (see ImplicitStep), with at most kMaxNewton linear solves, and a line search that may shorten
+// a Newton step down to kMinLineSearchStep.
+constexpr double kNewtonTolerance = 1e-2;
+constexpr int kMaxNewton = 12;
+constexpr double kMinLineSearchStep = 1.0 / 64;
+// Kinetic energy above this multiple of EnergyBound() is a blow-up (the bound is already
+// generous; the factor keeps a violent but physical transient, e.g. a whipping free end,
+// clear of it).
+constexpr double kEnergyBlowUp = 10;
+
+// Scratch memory of one evaluation, carved from the caller's workspace.
+struct Work {
+  double* f;     // 3 x n   node forces
+  double* t;     // 3 x N   unit segment tangents
+  double* l;     // N       segment lengths
+  double* T;     // N       segment tensions
+  double* M;     // 3 x n   nodal bending moments
+  double* q;     // 3 x n   unit node tangents
+  double* x2;    // 3 x n   state copy for Reactions
+  double* v2;    // 3 x n
+  double* rhs;   // 3 x n   implicit right-hand side / velocity change
+  double* band;  // 27 x n  implicit block-band matrix (3x3 blocks, block_band.h)
+  double* xs;    // 3 x n   state saved before an implicit step, to retry it in halves
+  double* vs;    // 3 x n
+  double* x0;    // 3 x n   state at the start of a two-stage step (implicit2)
+  double* v0;    // 3 x n
+  double* dv;    // 3 x n   implicit Newton correction (line search)
+  double* vb;    // 3 x n   implicit iterate the line search starts from
+  static int Size(int N) {
+    const int n = N + 1;
+    return 3 * n + 3 * N + N + N + 3 * n + 3 * n + 3 * n + 3 * n + 3 * n +
+           BlockBand::Size(n) + 18 * n;
+  }
+  Work(double* w, int N) {
+    const int n = N + 1;
+    f = w;
+    t = f + 3 * n;
+    l = t + 3 * N;
+    T = l + N;
+    M = T + N;
+    q = M + 3 * n;
+    x2 = q + 3 * n;
+    v2 = x2 + 3 * n;
+    rhs = v2 + 3 * n;
+    band = rhs + 3 * n;
+    xs = band + BlockBand::Size(n);
+    vs = xs + 3 * n;
+    x0 = vs + 3 * n;
+    v0 = x0 + 3 * n;
+    dv = v0 + 3 * n;
+    vb = dv + 3 * n;
+  }
+};
+
+// The window's inputs (x, v 3 x 3 each), outputs (f 3 x 3, T 2) and its own scratch follow
+// the tether's scratch.
+constexpr int kWindowIo = 9 + 9 + 9 + 2;
+
+}  // namespace detail
+}  // namespace mjtether

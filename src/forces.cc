@@ -1,0 +1,422 @@
+#include "tether.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "detail/work.h"
+
+namespace mjtether {
+using namespace detail;
+
+// ---------------------------------------------------------------------------------------------
+// Force terms. Convention: n_j = T_j t_j + V_j is the force that the part of the tether beyond
+// segment j exerts across it on the part before; node i receives n_i - n_{i-1}.
+
+void Tether::SegmentGeometry(ConstNodes x, Nodes t, double* l) const {
+  for (int j = 0; j < N_; ++j) {
+    Vec3 dx = x.col(j + 1) - x.col(j);
+    l[j] = dx.norm();
+    if (l[j] > kMinLengthRatio * L0_) {
+      t.col(j) = dx * (1 / l[j]);
+    } else {
+      t.col(j).setZero();
+      l[j] = 0;
+    }
+  }
+}
+
+// Axial: T_j = EA eps_j + damping deps_j/dt, eps_j = l_j/L0 - 1, zero when slack (eps <= 0)
+// and never negative (Buckham et al. 2003, eq. for the viscoelastic segment).
+//
+// With the compression effect (EAc declared) a shortened segment pushes back instead, the way
+// OrcaFlex lets a line "allow compression": for eps < 0, T_j = min(0, EAc eps_j + damping
+// deps_j/dt) (the mirror of the taut law: damping never makes a shortened segment pull). This
+// is what keeps the segments of a bending tether at their length at zero tension, where the
+// bending shear would otherwise fold them (the Galerkin curvature below, Buckham & Nahon,
+// weighs with the rest length L0, so it presumes segments near it). T[j] reports the tension
+// only (>= 0); a compression is reported as 0, like slack.
+// The law of one segment, from its strain eps, unit tangent t and the velocity difference dv of
+// its ends: EA eps + (damping/L0) t.dv, never negative, when stretched; EAc eps + the same
+// damping, never positive, when shortened with the compression effect; else 0.
+//
+// Engagement within an implicit step (engage_h > 0, the step's length [s], for a segment that
+// was on the other side of L0 at the start of the step): the damping acts on the strain rate of
+// the engaged law, d(eps+)/dt (eps+ = max(eps, 0), or min(eps, 0) for compression), whose
+// backward-Euler impulse over the step is damping (eps+ - 0), i.e. the rate is limited to
+// eps/engage_h in magnitude. The instantaneous law would jump from 0 to damping deps/dt as l
+// crosses L0, and the step's equations would then have no root (see ImplicitStep); this one
+// is continuous in l and converges to the same law as the step shrinks.
+inline double Tether::AxialForce(double eps, const Vec3& t, const Vec3& dv,
+                                 double engage_h) const {
+  const bool taut = eps > 0;
+  if (!taut && !(eps < 0 && Has(kCompression))) return 0;
+  double T = (taut ? p_.EA : p_.EAc) * eps;
+  if (Has(kDamping)) {
+    double rate = t.dot(dv);  // [m/s] L0 deps/dt
+    if (engage_h > 0) {
+      const double engaged = eps * L0_ / engage_h;  // [m/s] L0 eps/h
+      rate = taut ? std::min(rate, engaged) : std::max(rate, engaged);
+    }
+    T += damping_per_L0_ * rate;
+  }
+  return taut ? std::max(T, 0.0) : std::min(T, 0.0);
+}
+
+void Tether::AddAxial(ConstNodes x, ConstNodes v, ConstNodes t, const double* l, double* T,
+                      Nodes f, const Start* start) const {
+  (void)x;
+  const double inv_L0 = 1 / L0_;  // [1/m]
+  const double L0sq = L0_ * L0_;
+  const bool engaging = start && Has(kDamping);
+  for (int j = 0; j < N_; ++j) {
+    double engage_h = 0;
+    Vec3 dv = v.col(j + 1) - v.col(j);
+    if (engaging) {
+      // On the other side of L0 at the start of the step than now?
+      const double ls2 = (start->x.col(j + 1) - start->x.col(j)).squaredNorm();
+      if (l[j] > L0_ ? ls2 <= L0sq : l[j] < L0_ && ls2 >= L0sq) engage_h = start->h;
+      if (start->discrete) {
+        // In the Newton iterations past the first: the backward difference of the engaged
+        // strain over the step, (eps+ - max(eps_start, 0))/h (see ImplicitStep).
+        const double ls = std::sqrt(ls2);
+        const double from = l[j] > L0_ ? std::max(ls, L0_) : std::min(ls, L0_);
+        dv = t.col(j) * ((l[j] - from) / start->h);
+        engage_h = 0;
+      }
+    }
+    const double Tj = AxialForce(l[j] * inv_L0 - 1, t.col(j), dv, engage_h);
+    T[j] = std::max(Tj, 0.0);
+    f.col(j) += Tj * t.col(j);
+    f.col(j + 1) -= Tj * t.col(j);
+  }
+}
+
+// Bending moment at each node, M_i = EI kappa_i, with the Galerkin (lumped weight) curvature
+//   kappa_i = (t_{i-1} x t_i) / w_i,  w_i = integral of the hat function N_i = (L0_{i-1}+L0_i)/2
+// (Buckham & Nahon 1999: curvature from the jump of the piecewise-constant tangent, weighted
+// residual with linear shape functions). A clamped end uses its site axis as the tangent
+// before node 0 (or after node N) with w = L0/2; a pinned or free end has M = 0.
+//
+// With bending=der the curvature is that of the discrete elastic rod (Bergou et al., "Discrete
+// elastic rods", SIGGRAPH 2008), |kappa| = 2 tan(theta/2)/w, and M is the derivative of its
+// energy 2 EI/w tan^2(theta/2) with respect to theta: M = 4 EI/w (ta x tb)/(1 + ta.tb)^2.
+// Both equal EI theta/w to first order. (1 + ta.tb) is kept above 1e-2 (a node folded back
+// by more than ~170 degrees) so that the moment stays finite.
+void Tether::BendingMoments(ConstNodes t, const Ends& ends, Nodes M) const {
+  const bool der = p_.bending == Bending::kDER;
+  auto moment = [&](const Vec3& ta, const Vec3& tb, double w) -> Vec3 {
+    if (!der) return p_.EI / w * ta.cross(tb);
+    const double c = std::max(1 + ta.dot(tb), 1e-2);
+    return 4 * p_.EI / (w * c * c) * ta.cross(tb);
+  };
+  M.setZero();
+  for (int i = 1; i < N_; ++i) {
+    M.col(i) = moment(t.col(i - 1), t.col(i), L0_);
+  }
+  if (Has(kClamp) && p_.clamp_a) {
+    M.col(0) = moment(ends.a.axis, t.col(0), 0.5 * L0_);
+  }
+  if (Has(kClamp) && p_.clamp_b) {
+    M.col(N_) = moment(t.col(N_ - 1), ends.b.axis, 0.5 * L0_);
+  }
+}
+
+// Shear from the moment gradient with no rotational inertia (dM/ds + t x n = 0):
+//   V_j = t_j x (M_{j+1} - M_j) / l_j,
+// added as +V_j on node j and -V_j on node j+1.
+void Tether::AddBending(ConstNodes t, const double* l, ConstNodes M, Nodes f) const {
+  for (int j = 0; j < N_; ++j) {
+    if (l[j] == 0) continue;
+    Vec3 V = Vec3(t.col(j)).cross(Vec3(M.col(j + 1) - M.col(j))) / l[j];
+    f.col(j) += V;
+    f.col(j + 1) -= V;
+  }
+}
+
+// Node tangent: the normalised sum of the adjacent segment tangents (the segment's own at an
+// end). Used for drag, added mass and seabed friction.
+void Tether::NodeTangents(ConstNodes x, ConstNodes t, Nodes q) const {
+  (void)x;
+  for (int i = 0; i <= N_; ++i) {
+    Vec3 s = Vec3::Zero();
+    if (i > 0) s += t.col(i - 1);
+    if (i < N_) s += t.col(i);
+    double norm = s.norm();
+    q.col(i) = norm > 1e-12 ? Vec3(s * (1 / norm)) : Vec3(t.col(std::min(i, N_ - 1)));
+  }
+}
+
+// Morison drag on the velocity relative to the current u, per unit length (length share
+// l_i = (l_{i-1} + l_i)/2, stretched):
+//   f_n = 1/2 rho Cdn d |vn| vn,   f_t = 1/2 rho Cdt pi d |vt| vt,   v_r = u - v_i.
+void Tether::AddDrag(ConstNodes v, ConstNodes q, const double* l, Nodes f) const {
+  const Vec3 u = Has(kCurrent) ? env_.water.current : Vec3::Zero();
+  for (int i = 0; i <= N_; ++i) {
+    const double li = 0.5 * ((i > 0 ? l[i - 1] : 0) + (i < N_ ? l[i] : 0));
+    const Vec3 vr = u - v.col(i);
+    const Vec3 qi = q.col(i);
+    const double vq = vr.dot(qi);  // |vt| = |vq|: q is a unit vector
+    const Vec3 vn = vr - vq * qi;
+    f.col(i) += li * (kn_ * vn.norm() * vn + (kt_ * std::abs(vq) * vq) * qi);
+  }
+}
+
+// Flat seabed at z = zb: a penalty per unit length (rest share l_i) on penetration
+//   N_i = max(0, k l_i (zb - z_i) - c l_i vz_i),
+// and Coulomb friction smoothed by tanh over the slip speed, separately along the tether's
+// horizontal tangent (mu_axial) and across it (mu).
+//
+// Within an implicit step (start given), a node that was above the seabed at the start of the
+// step and is in contact at its end has its damping act on d(pen+)/dt, as AxialForce does for
+// a segment crossing L0: the sink rate is limited to pen/h, so that the normal force does not
+// jump from 0 to c |vz| at first contact.
+void Tether::AddSeabed(ConstNodes x, ConstNodes v, ConstNodes q, Nodes f,
+                       const Start* start) const {
+  const Water& w = env_.water;
+  for (int i = 0; i <= N_; ++i) {
+    const double pen = w.seabed - x(2, i);
+    if (pen <= 0) continue;
+    double sink = -v(2, i);  // [m/s]
+    if (start && start->x(2, i) >= w.seabed) sink = std::min(sink, pen / start->h);
+    const double N = std::max(0.0, share_(i) * (seabed_k_ * pen + seabed_c_ * sink));
+    f(2, i) += N;
+    if (w.seabed_friction == 0 && w.seabed_friction_axial == 0) continue;
+    Vec3 qh(q(0, i), q(1, i), 0);
+    qh = qh.norm() > 1e-12 ? Vec3(qh.normalized()) : Vec3::Zero();
+    const Vec3 vh(v(0, i), v(1, i), 0);
+    const Vec3 va = vh.dot(qh) * qh, vc = vh - va;
+    const double eps = w.seabed_friction_speed;
+    if (va.norm() > 0) f.col(i) -= w.seabed_friction_axial * N * std::tanh(va.norm() / eps) *
+                                    va.normalized();
+    if (vc.norm() > 0) f.col(i) -= w.seabed_friction * N * std::tanh(vc.norm() / eps) *
+                                   vc.normalized();
+  }
+}
+
+// Contact with another body's surface (contact.h): on the point x_s of segment j at fraction s,
+// a penalty per unit length (the segment's rest length L0) on the penetration of the tether's
+// surface, with damping on the normal approach speed, never pulling:
+//   N = max(0, L0 (k (-g) - c vn)),  g = n.(x_s - p(t)) - d/2,  vn = n.(v_s - v_b),
+// and Coulomb friction on the slip velocity vt = (v_s - v_b) - vn n, smoothed like the
+// seabed's: -mu N tanh(|vt|/eps) vt/|vt|. The force acts at x_s, shared (1 - s), s by the
+// segment's two nodes (the linear shape functions). dt_ref = t - time_ref.
+Vec3 Tether::ContactForce(const ContactPoint& c, const double* xp, const double* vp, double dt_ref,
+                          double* normal_force) const {
+  ConstNodes x(xp, 3, N_ + 1), v(vp, 3, N_ + 1);
+  const int j = c.segment;
+  const double s = c.s;
+  const Vec3 xs = (1 - s) * x.col(j) + s * x.col(j + 1);
+  const Vec3 p = c.point + dt_ref * c.velocity;
+  const double gap = c.normal.dot(xs - p) - 0.5 * p_.diameter;
+  *normal_force = 0;
+  if (!(gap < 0)) return Vec3::Zero();
+  const Vec3 vrel = (1 - s) * v.col(j) + s * v.col(j + 1) - c.velocity;
+  const double vn = c.normal.dot(vrel);
+  const double N = std::max(0.0, L0_ * (contact_k_ * -gap - contact_c_ * vn));
+  *normal_force = N;
+  Vec3 F = N * c.normal;
+  if (p_.contact_friction > 0 && N > 0) {
+    const Vec3 vt = vrel - vn * c.normal;
+    const double slip = vt.norm();
+    if (slip > 0) {
+      F -= (p_.contact_friction * N * std::tanh(slip / p_.contact_friction_speed) / slip) * vt;
+    }
+  }
+  return F;
+}
+
+void Tether::AddContact(ConstNodes x, ConstNodes v, const Ends& ends, Nodes f) const {
+  const ContactSet& set = *ends.contacts;
+  const double dt_ref = ends.time - set.time_ref;
+  for (int k = 0; k < set.count; ++k) {
+    const ContactPoint& c = set.points[k];
+    double N;
+    const Vec3 F = ContactForce(c, x.data(), v.data(), dt_ref, &N);
+    if (N == 0) continue;
+    f.col(c.segment) += (1 - c.s) * F;
+    f.col(c.segment + 1) += c.s * F;
+  }
+}
+
+// Adds weight x the contact force of the state (x, v) at `ends` to each candidate's impulse
+// (or to its `stage` scratch): each integrator calls it with the weights by which its update
+// combines the forces of its stages, so that the impulses are the ones the tether received.
+void Tether::AccumulateContactImpulse(const double* x, const double* v, const Ends& ends,
+                                      double weight, bool to_stage) const {
+  if (!Has(kContact) || !ends.contacts) return;
+  const ContactSet& set = *ends.contacts;
+  const double dt_ref = ends.time - set.time_ref;
+  for (int k = 0; k < set.count; ++k) {
+    ContactPoint& c = set.points[k];
+    double N;
+    const Vec3 F = ContactForce(c, x, v, dt_ref, &N);
+    (to_stage ? c.stage : c.impulse) += weight * F;
+  }
+}
+
+void Tether::ComputeForces(const double* xp, const double* vp, const Ends& ends, double* fp,
+                           double* Tp, double* work) const {
+  Forces(xp, vp, ends, fp, Tp, work, nullptr);
+}
+
+void Tether::Forces(const double* xp, const double* vp, const Ends& ends, double* fp, double* Tp,
+                    double* work, const Start* start) const {
+  Work w(work, N_);
+  const int n = N_ + 1;
+  ConstNodes x(xp, 3, n), v(vp, 3, n);
+  Nodes f(fp, 3, n), t(w.t, 3, N_), M(w.M, 3, n), q(w.q, 3, n);
+  ConstNodes tc(w.t, 3, N_), Mc(w.M, 3, n), qc(w.q, 3, n);
+  double* T = Tp ? Tp : w.T;
+  f.setZero();
+  SegmentGeometry(x, t, w.l);
+  std::fill(T, T + N_, 0.0);
+  if (Has(kAxial)) AddAxial(x, v, tc, w.l, T, f, start);
+  if (Has(kBending)) {
+    BendingMoments(tc, ends, M);
+    AddBending(tc, w.l, Mc, f);
+  }
+  if (Has(kWeight) || Has(kBuoyancy)) f += weight_;
+  if (Has(kDrag) || Has(kAddedMass) || Has(kSeabed)) NodeTangents(x, tc, q);
+  if (Has(kDrag)) AddDrag(v, qc, w.l, f);
+  if (Has(kSeabed)) AddSeabed(x, v, qc, f, start);
+  if (Has(kContact) && ends.contacts) AddContact(x, v, ends, f);
+}
+
+EndReactions Tether::Reactions(const double* xp, const double* vp, const Ends& ends,
+                               double* work) const {
+  Work w(work, N_);
+  const int n = N_ + 1;
+  if (window_) {
+    // Each end from its 3-node window: the force on an end node involves only its segment,
+    // the curvature at its neighbour (the segment after) and its own drag, weight and seabed.
+    const Tether& wt = *window_;
+    double* io = work + Work::Size(N_);
+    double *wx = io, *wv = io + 9, *wf = io + 18, *wT = io + 27;
+    double* scratch = io + kWindowIo;
+    ConstNodes x(xp, 3, n), v(vp, 3, n);
+    Nodes X(wx, 3, 3), V(wv, 3, 3);
+    // The window knows nothing of the candidates (they index the whole tether): the contact
+    // share of each end node is added below.
+    Ends we = ends;
+    we.contacts = nullptr;
+    auto contact_on_node = [&](int i) {
+      Vec3 F = Vec3::Zero();
+      if (!Has(kContact) || !ends.contacts) return F;
+      const ContactSet& set = *ends.contacts;
+      for (int k = 0; k < set.count; ++k) {
+        const ContactPoint& c = set.points[k];
+        if (c.segment != i && c.segment != i - 1) continue;
+        double N;
+        const Vec3 Fc = ContactForce(c, x.data(), v.data(), ends.time - set.time_ref, &N);
+        F += (c.segment == i ? 1 - c.s : c.s) * Fc;
+      }
+      return F;
+    };
+    ConstNodes F(wf, 3, 3), M(Work(scratch, 2).M, 3, 3);
+    EndReactions r;
+    X.col(0) = ends.a.pos;
+    V.col(0) = ends.a.vel;
+    X.rightCols(2) = x.middleCols(1, 2);
+    V.rightCols(2) = v.middleCols(1, 2);
+    wt.ComputeForces(wx, wv, we, wf, wT, scratch);
+    r.force_a = F.col(0) + contact_on_node(0);
+    r.tension_a = r.force_a.norm();
+    if (Has(kClamp) && p_.clamp_a) r.torque_a = M.col(0);
+    X.leftCols(2) = x.middleCols(N_ - 2, 2);
+    V.leftCols(2) = v.middleCols(N_ - 2, 2);
+    X.col(2) = p_.free_end ? Vec3(x.col(N_)) : ends.b.pos;
+    V.col(2) = p_.free_end ? Vec3(v.col(N_)) : ends.b.vel;
+    wt.ComputeForces(wx, wv, we, wf, wT, scratch);
+    if (p_.free_end) {
+      r.tension_b = wT[1];
+    } else {
+      r.force_b = F.col(2) + contact_on_node(N_);
+      r.tension_b = r.force_b.norm();
+      if (Has(kClamp) && p_.clamp_b) r.torque_b = -M.col(2);
+    }
+    return r;
+  }
+  Nodes x(w.x2, 3, n), v(w.v2, 3, n);
+  x = ConstNodes(xp, 3, n);
+  v = ConstNodes(vp, 3, n);
+  x.col(0) = ends.a.pos;
+  v.col(0) = ends.a.vel;
+  if (!p_.free_end) {
+    x.col(N_) = ends.b.pos;
+    v.col(N_) = ends.b.vel;
+  }
+  ComputeForces(w.x2, w.v2, ends, w.f, w.T, work);
+  ConstNodes f(w.f, 3, n), M(w.M, 3, n);
+  EndReactions r;
+  r.force_a = f.col(0);
+  r.tension_a = r.force_a.norm();
+  if (Has(kClamp) && p_.clamp_a) r.torque_a = M.col(0);
+  if (p_.free_end) {
+    r.tension_b = w.T[N_ - 1];
+  } else {
+    r.force_b = f.col(N_);
+    r.tension_b = r.force_b.norm();
+    if (Has(kClamp) && p_.clamp_b) r.torque_b = -M.col(N_);
+  }
+  return r;
+}
+
+// Tension only: a compressed segment (compression effect) reads 0, like a slack one.
+void Tether::Tensions(const double* xp, const double* vp, double* T) const {
+  ConstNodes x(xp, 3, N_ + 1), v(vp, 3, N_ + 1);
+  const double inv_L0 = 1 / L0_;  // [1/m]
+  for (int j = 0; j < N_; ++j) {
+    const Vec3 dx = x.col(j + 1) - x.col(j);
+    const double l = dx.norm();
+    T[j] = 0;
+    if (Has(kAxial) && l > L0_) {
+      T[j] = AxialForce(l * inv_L0 - 1, dx * (1 / l), v.col(j + 1) - v.col(j), 0);
+    }
+  }
+}
+
+double Tether::KineticEnergy(const double* xp, const double* vp) const {
+  ConstNodes x(xp, 3, N_ + 1), v(vp, 3, N_ + 1);
+  double E = 0;
+  for (int i = 0; i <= N_; ++i) {
+    E += 0.5 * mass_(i) * v.col(i).squaredNorm();
+    if (added_(i) > 0) {
+      Vec3 s = x.col(std::min(i + 1, N_)) - x.col(std::max(i - 1, 0));
+      Vec3 q = s.norm() > 0 ? Vec3(s.normalized()) : Vec3::Zero();
+      Vec3 vn = v.col(i) - v.col(i).dot(q) * q;
+      E += 0.5 * added_(i) * vn.squaredNorm();
+    }
+  }
+  return E;
+}
+
+double Tether::PotentialEnergy(const double* xp, const Ends& ends) const {
+  ConstNodes x(xp, 3, N_ + 1);
+  double E = 0;
+  Vec3 t_prev = Vec3::Zero();
+  for (int j = 0; j < N_; ++j) {
+    Vec3 dx = x.col(j + 1) - x.col(j);
+    const double l = dx.norm();
+    if (Has(kAxial) && l > L0_) E += 0.5 * p_.EA / L0_ * (l - L0_) * (l - L0_);
+    if (Has(kCompression) && l < L0_) E += 0.5 * p_.EAc / L0_ * (l - L0_) * (l - L0_);
+    Vec3 t = l > 0 ? Vec3(dx / l) : Vec3::Zero();
+    // Bending: the potential of the forces of AddBending is EI/w (1 - cos theta) per node
+    // (theta the turning angle, w the curvature weight), since M = EI sin(theta)/w.
+    // With bending=der: 2 EI/w tan^2(theta/2) = 2 EI/w (1 - cos)/(1 + cos).
+    if (Has(kBending)) {
+      auto energy = [&](const Vec3& ta, const Vec3& tb, double w) {
+        const double c = ta.dot(tb);
+        if (p_.bending != Bending::kDER) return p_.EI / w * (1 - c);
+        return 2 * p_.EI / w * (1 - c) / std::max(1 + c, 1e-2);
+      };
+      if (j > 0) E += energy(t_prev, t, L0_);
+      if (j == 0 && Has(kClamp) && p_.clamp_a) E += energy(ends.a.axis, t, 0.5 * L0_);
+      if (j == N_ - 1 && Has(kClamp) && p_.clamp_b) E += energy(t, ends.b.axis, 0.5 * L0_);
+    }
+    t_prev = t;
+  }
+  for (int i = 0; i <= N_; ++i) E -= weight_.col(i).dot(x.col(i));
+  return E;
+}
+
+}  // namespace mjtether

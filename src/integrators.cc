@@ -1,0 +1,633 @@
+#include "tether.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "detail/work.h"
+
+namespace mjtether {
+using namespace detail;
+namespace {
+
+// Cubic Hermite interpolation of an end between two instants dt apart, at fraction s.
+EndState Interpolate(const EndState& e0, const EndState& e1, double dt, double s) {
+  const double s2 = s * s, s3 = s2 * s;
+  const double h00 = 2 * s3 - 3 * s2 + 1, h10 = s3 - 2 * s2 + s;
+  const double h01 = -2 * s3 + 3 * s2, h11 = s3 - s2;
+  const double d00 = 6 * s2 - 6 * s, d10 = 3 * s2 - 4 * s + 1;
+  const double d01 = -6 * s2 + 6 * s, d11 = 3 * s2 - 2 * s;
+  EndState e;
+  e.pos = h00 * e0.pos + h10 * dt * e0.vel + h01 * e1.pos + h11 * dt * e1.vel;
+  e.vel = dt > 0 ? ((d00 * e0.pos + d01 * e1.pos) / dt + d10 * e0.vel + d11 * e1.vel)
+                 : e1.vel;
+  Vec3 axis = (1 - s) * e0.axis + s * e1.axis;
+  e.axis = axis.norm() > 0 ? Vec3(axis.normalized()) : e1.axis;
+  return e;
+}
+
+Ends Interpolate(const Ends& from, const Ends& to, double dt, double s) {
+  return {Interpolate(from.a, to.a, dt, s), Interpolate(from.b, to.b, dt, s),
+          from.time + s * (to.time - from.time), to.contacts};
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Integrators
+
+// The attached end nodes at the ends' positions and velocities `e` (end B only if attached).
+void Tether::PlaceEnds(const Ends& e, Nodes x, Nodes v) const {
+  x.col(0) = e.a.pos;
+  v.col(0) = e.a.vel;
+  if (!p_.free_end) {
+    x.col(N_) = e.b.pos;
+    v.col(N_) = e.b.vel;
+  }
+}
+
+// Acceleration of dynamic node i under force fi [N], node tangent qi: with normal added mass
+// the node mass matrix is m I + ma (I - q q^T), whose inverse is q q^T/m + (I - q q^T)/(m + ma).
+inline Vec3 Tether::Acceleration(int i, const Vec3& fi, const Vec3& qi) const {
+  if (!Has(kAddedMass)) return inv_mass_(i) * fi;
+  const Vec3 ft = fi.dot(qi) * qi;
+  return inv_mass_(i) * ft + inv_mass_normal_(i) * (fi - ft);
+}
+
+// Symplectic (semi-implicit) Euler: v += h M^-1 f(x, v); x += h v.
+void Tether::ExplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
+                          double* work) const {
+  Work w(work, N_);
+  ComputeForces(x.data(), v.data(), now, w.f, nullptr, work);
+  AccumulateContactImpulse(x.data(), v.data(), now, h, false);  // v+ = v + h M^-1 f(x, v)
+  ConstNodes f(w.f, 3, N_ + 1), q(w.q, 3, N_ + 1);
+  for (int i = 1; i <= N_; ++i) {
+    if (!Dynamic(i)) continue;
+    v.col(i) += h * Acceleration(i, f.col(i), q.col(i));
+    x.col(i) += h * v.col(i);
+  }
+  PlaceEnds(next, x, v);
+}
+
+// Classical fourth-order Runge-Kutta (Kutta 1901; Hairer, Norsett & Wanner, Solving ODEs I,
+// table II.1.2) on y = (x, v), y' = (v, M^-1 f(x, v)), with the attached ends at t, t + h/2 and
+// t + h from their Hermite curve. MoorDyn offers the same scheme for its lines. Four force
+// evaluations per step, but fourth order, and a stability region that reaches 2.8/w along
+// both the imaginary and the negative real axis (symplectic Euler: 2/w, less with damping),
+// so at its own limit it costs 1.1-1.5x symplectic Euler per simulated second on a damped
+// line (about 3x where undamped bending sets the step) and is far more accurate.
+void Tether::Rk4Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
+                     double* work) const {
+  Work w(work, N_);
+  const int n = N_ + 1;
+  Nodes xk(w.x2, 3, n), vk(w.v2, 3, n), dx(w.xs, 3, n), dv(w.vs, 3, n);
+  ConstNodes f(w.f, 3, n), q(w.q, 3, n);
+  const Ends mid = Interpolate(now, next, h, 0.5);
+  // Stage k at (xk, vk), ends `e`: k_k = (vk, a_k) is added to the sum (dx, dv) with weight
+  // b = 1, 2, 2, 1, and the next stage state is y + c h k_k with c = 1/2, 1/2, 1; the last
+  // stage completes y + h/6 (k1 + 2 k2 + 2 k3 + k4). One pass over the nodes per stage.
+  xk = x;
+  vk = v;
+  const Ends* ends[4] = {&now, &mid, &mid, &next};
+  const double b[4] = {1, 2, 2, 1}, c[3] = {0.5 * h, 0.5 * h, h};
+  for (int k = 0; k < 4; ++k) {
+    const Ends& e = *ends[k];
+    PlaceEnds(e, xk, vk);
+    ComputeForces(w.x2, w.v2, e, w.f, nullptr, work);
+    AccumulateContactImpulse(xk.data(), vk.data(), e, b[k] * h / 6, false);
+    for (int i = 0; i < n; ++i) {
+      if (!Dynamic(i)) continue;
+      const Vec3 ai = Acceleration(i, f.col(i), q.col(i)), vi = vk.col(i);
+      if (k == 0) {
+        dx.col(i) = vi;
+        dv.col(i) = ai;
+      } else {
+        dx.col(i) += b[k] * vi;
+        dv.col(i) += b[k] * ai;
+      }
+      if (k < 3) {
+        xk.col(i) = x.col(i) + c[k] * vi;
+        vk.col(i) = v.col(i) + c[k] * ai;
+      } else {
+        x.col(i) += (h / 6) * dx.col(i);
+        v.col(i) += (h / 6) * dv.col(i);
+      }
+    }
+  }
+  PlaceEnds(next, x, v);
+}
+
+// Backward Euler, solved by Newton's method on the velocities at the end of the step:
+//   G(v+) = M (v+ - v) - h f(x + h v+, v+) = 0,
+//   (M - h D - h^2 K) dv = -G,   K = df/dx, D = df/dv at the current iterate,
+// starting from v+ = v with the attached ends already at their positions and velocities at
+// the end of the step. The linear system is the one of Baraff & Witkin (SIGGRAPH 1998).
+//
+// With smooth forces one iteration suffices (linearly implicit Euler) and the step takes it
+// when no segment changed between slack (or compressed) and taut within it and the tension
+// that segments turning within the step made the linearisation miss stays below
+// kLinearisationTolerance of the largest. Otherwise the law that applies changed at l = L0
+// (from nothing or EAc to EA): G is only piecewise smooth there, with kinks where a segment
+// goes slack, a damped tension is clipped at zero or a node touches the seabed. (It has no
+// jumps: a segment or a seabed contact that engages within the step takes the engaged damping
+// law of AxialForce and AddSeabed, without which G jumps by h damping deps/dt as l crosses L0
+// and has no root at all.) In these iterations the axial damping acts on the backward
+// difference of the engaged strain over the step, (eps+ - max(eps, 0))/h, instead of
+// t+ . (v+_{j+1} - v+_j)/L0: the two differ by l theta^2/(2 h L0) for a segment turning by
+// theta in the step (first order in h, as backward Euler itself), but the difference depends
+// on the lengths only, so its Jacobian is the symmetric (EA + damping/h)/L0 t t^T the matrix
+// holds, where the rate along the turning tangent adds a non-symmetric term (damping h/(L0 l))
+// t (P dv)^T that the matrix cannot hold and without which heavily damped slack tethers made
+// the line search fail. The iteration then goes on as a semismooth Newton method (Qi & Sun,
+// Math. Programming 58, 1993: the Jacobian of the piece the iterate is on is an element of
+// the generalised Jacobian) with a backtracking line search on the merit function
+// phi = 1/2 sum_i |G_i|^2/m_i (Armijo; Nocedal & Wright, Numerical Optimization, 2006, ch. 3
+// and 11), which stops the slack/taut cycling of the plain iteration: each accepted iterate
+// lowers phi. It stops when every node's velocity error |G_i|/m_i is below
+// kNewtonTolerance of the largest velocity change of the step (plus a round-off floor).
+// Returns false if it stalled (kMaxNewton iterations, or a line search that found no descent);
+// the caller then retries the step in two halves and counts it.
+//
+// K holds the axial stiffness EA/L0 t t^T + T/l (I - t t^T) of taut segments, the small-angle
+// bending stiffness EI/w g g^T (g the second-difference stencil of the curvature), and the
+// seabed stiffness; D the axial damping, the drag and seabed damping, and the secant of the
+// friction. Every block is symmetric and K <= 0, D <= 0, so the matrix is SPD and banded
+// (3x3 blocks, two off-diagonals with bending, one without): a block Cholesky with fixed-size
+// 3x3 blocks (block_band.h) solves it, assembled directly block by block.
+bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
+                          double* work, StepStatus* stats) const {
+  (void)now;
+  Work w(work, N_);
+  const int n = N_ + 1;
+  const int nu = N_ - 1 + (p_.free_end ? 1 : 0);  // dynamic nodes 1..nu, unknown u = i - 1
+  Nodes xk(w.x2, 3, n), vk(w.v2, 3, n);
+  // Initial iterate: velocities unchanged, ends at the end of the step.
+  vk = v;
+  vk.col(0) = next.a.vel;
+  if (!p_.free_end) vk.col(N_) = next.b.vel;
+  auto place = [&]() {
+    xk = x + h * vk;
+    xk.col(0) = next.a.pos;
+    if (!p_.free_end) xk.col(N_) = next.b.pos;
+  };
+  place();
+  if (nu == 0) {
+    x = xk;
+    v = vk;
+    return true;
+  }
+  ConstNodes f(w.f, 3, n), t(w.t, 3, N_), q(w.q, 3, n);
+  BlockBand A(w.band, nu, Has(kBending) ? 2 : 1);
+  Nodes rhs(w.rhs, 3, nu), dv(w.dv, 3, nu), vb(w.vb, 3, nu);
+  const Mat3 I = Mat3::Identity();
+  const double h2 = h * h;
+  const bool added = Has(kAddedMass);
+  Start start{ConstNodes(x.data(), 3, n), h, false};
+
+  // Forces at the iterate, and the residual -G = h f - M (v+ - v) (node mass with normal added
+  // mass) into rhs. Returns phi*2 and, in *err, the largest |G_i|/m_i [m/s].
+  auto residual = [&](double* err) {
+    place();
+    Forces(w.x2, w.v2, next, w.f, w.T, work, &start);
+    double phi = 0, worst = 0;
+    for (int i = 1; i <= nu; ++i) {
+      const Vec3 dvi = vk.col(i) - v.col(i);
+      Vec3 r = h * f.col(i) - mass_(i) * dvi;
+      if (added) {
+        const Vec3 qi = q.col(i);
+        r -= added_(i) * (dvi - qi.dot(dvi) * qi);
+      }
+      rhs.col(i - 1) = r;
+      const double r2 = r.squaredNorm();
+      phi += r2 * inv_mass_(i);
+      worst = std::max(worst, r2 * inv_mass_(i) * inv_mass_(i));
+    }
+    *err = std::sqrt(worst);
+    return phi;
+  };
+
+  // The matrix M - h D - h^2 K at the iterate of the last residual, factored; the Newton
+  // correction replaces the residual in rhs. False if the factorisation failed.
+  bool newton = false;  // past the first iteration
+  auto solve = [&]() {
+    A.SetZero();
+    for (int i = 1; i <= nu; ++i) {
+      BlockBand::Block d = A.D(i - 1);
+      if (added) {
+        const Vec3 qi = q.col(i);
+        d = mass_(i) * I + added_(i) * (I - qi * qi.transpose());
+      } else {
+        d.diagonal().setConstant(mass_(i));
+      }
+    }
+    // Axial stiffness and damping of taut segments: B = h D + h^2 K with
+    // K = EA/L0 t t^T + T/l (I - t t^T), D = damping/L0 t t^T; +B on both diagonal blocks,
+    // -B on the coupling block.
+    // A compressed segment (compression effect, 0 < l < L0) adds h^2 EAc/L0 t t^T and its
+    // damping while it pushes, without the geometric term -|T|/l (I - t t^T): that negative
+    // stiffness (buckling) would make the matrix indefinite, and bending carries it instead.
+    if (Has(kAxial)) {
+      const double ka = p_.EA / L0_;
+      const double kc = p_.EAc / L0_;
+      const double ca = Has(kDamping) ? p_.damping / L0_ : 0;
+      const bool compression = Has(kCompression);
+      for (int j = 0; j < N_; ++j) {
+        const bool taut = w.l[j] > L0_;
+        if (!taut && !(compression && w.l[j] > 0 && w.l[j] < L0_)) continue;
+        const Vec3 tj = t.col(j);
+        Mat3 B;
+        if (taut) {
+          // In the Newton iterations after the first, a taut segment whose damped tension is
+          // clipped at zero (it shortens faster than EA eps/damping) is on the piece where
+          // the law is 0: its Jacobian there is 0 (the first keeps the linearly implicit step's
+          // matrix of before).
+          if (newton && !(w.T[j] > 0)) continue;
+          const double geo = h2 * w.T[j] / w.l[j];
+          const double along = h2 * ka + (w.T[j] > 0 ? h * ca : 0) - geo;
+          B = along * tj * tj.transpose() + geo * I;
+        } else {
+          const double rate = tj.dot(vk.col(j + 1) - vk.col(j)) / L0_;  // [1/s] deps/dt
+          const bool pushes = p_.EAc * (w.l[j] / L0_ - 1) + ca * L0_ * rate < 0;
+          B = (h2 * kc + (pushes ? h * ca : 0)) * tj * tj.transpose();
+        }
+        const bool d0 = Dynamic(j), d1 = Dynamic(j + 1);
+        if (d0) A.D(j - 1) += B;
+        if (d1) A.D(j) += B;
+        if (d0 && d1) A.L1(j) -= B;
+      }
+    }
+    // Bending: K = -EI/w g g^T I on the stencil of each curvature; B = h^2 EI/(w L0^2) g g^T I.
+    // Every block is a multiple of I: the stencils add scalars per block row (on the diagonal,
+    // first and second band), gathered in the free moment buffer, then one pass adds them.
+    if (Has(kBending)) {
+      double* band0 = w.M;  // 3 x n scratch (the moments are no longer needed): D, L1, L2
+      std::fill(band0, band0 + 3 * n, 0.0);
+      auto stencil = [&](int first, const double* g, int count, double weight) {
+        const double k = h2 * p_.EI / (weight * L0_ * L0_);
+        for (int a = 0; a < count; ++a) {
+          const int ia = first + a;
+          if (!Dynamic(ia)) continue;
+          for (int b = 0; b <= a; ++b) {
+            if (!Dynamic(first + b)) continue;
+            band0[3 * (ia - 1) + (a - b)] += k * g[a] * g[b];
+          }
+        }
+      };
+      const double g3[3] = {1, -2, 1}, g2[2] = {-1, 1};
+      for (int i = 1; i < N_; ++i) stencil(i - 1, g3, 3, L0_);
+      if (Has(kClamp) && p_.clamp_a) stencil(0, g2, 2, 0.5 * L0_);
+      if (Has(kClamp) && p_.clamp_b) stencil(N_ - 1, g2, 2, 0.5 * L0_);
+      for (int u = 0; u < nu; ++u) {
+        A.D(u).diagonal().array() += band0[3 * u];
+        if (u >= 1) A.L1(u).diagonal().array() += band0[3 * u + 1];
+        if (u >= 2) A.L2(u).diagonal().array() += band0[3 * u + 2];
+      }
+    }
+    // Drag: d(|vn| vn)/dv_r = |vn| P + vn vn^T/|vn|, d(|vt| vt)/dv_r = 2 |vt| q q^T; B = -h D.
+    if (Has(kDrag)) {
+      const Vec3 u = Has(kCurrent) ? env_.water.current : Vec3::Zero();
+      for (int i = 1; i <= nu; ++i) {
+        const double li = 0.5 * (w.l[i - 1] + (i < N_ ? w.l[i] : 0));
+        const Vec3 qi = q.col(i);
+        const Vec3 vr = u - vk.col(i);
+        const double vq = vr.dot(qi);
+        const Vec3 vn = vr - vq * qi;
+        const double vnn = vn.norm();
+        const double ht = h * li;
+        Mat3 J = (ht * (kt_ * 2 * std::abs(vq) - kn_ * vnn)) * qi * qi.transpose();
+        J.diagonal().array() += ht * kn_ * vnn;
+        if (vnn > 0) J += (ht * kn_ / vnn) * vn * vn.transpose();
+        A.D(i - 1) += J;
+      }
+    }
+    // Seabed: normal stiffness and damping, friction secant.
+    if (Has(kSeabed)) {
+      const Water& wt = env_.water;
+      for (int i = 1; i <= nu; ++i) {
+        const double pen = wt.seabed - xk(2, i);
+        if (pen <= 0) continue;
+        BlockBand::Block d = A.D(i - 1);
+        d(2, 2) += h2 * seabed_k_ * share_(i) + h * seabed_c_ * share_(i);
+        const double N = std::max(0.0, share_(i) * (seabed_k_ * pen - seabed_c_ * vk(2, i)));
+        const double mu = std::max(wt.seabed_friction, wt.seabed_friction_axial);
+        const double vh = std::hypot(vk(0, i), vk(1, i));
+        const double eps = wt.seabed_friction_speed;
+        const double secant = vh > 1e-9 * eps ? mu * N * std::tanh(vh / eps) / vh : mu * N / eps;
+        d(0, 0) += h * secant;
+        d(1, 1) += h * secant;
+      }
+    }
+    // Contact: normal stiffness and damping L0 (h^2 k + h c) n n^T and the friction's
+    // derivative in the tangent plane at the contact point, shared by the segment's
+    // nodes with the weights (1 - s), s of the force (so w_a w_b on each block).
+    if (Has(kContact) && next.contacts) {
+      const ContactSet& set = *next.contacts;
+      const double dt_ref = next.time - set.time_ref;
+      for (int k = 0; k < set.count; ++k) {
+        const ContactPoint& c = set.points[k];
+        double N;
+        ContactForce(c, xk.data(), vk.data(), dt_ref, &N);
+        const Vec3 xs = (1 - c.s) * xk.col(c.segment) + c.s * xk.col(c.segment + 1);
+        if (!(c.normal.dot(xs - c.point - dt_ref * c.velocity) < 0.5 * p_.diameter)) continue;
+        const Mat3 nn = c.normal * c.normal.transpose();
+        Mat3 B = (L0_ * (h2 * contact_k_ + h * contact_c_)) * nn;
+        if (p_.contact_friction > 0 && N > 0) {
+          const Vec3 vrel = (1 - c.s) * vk.col(c.segment) + c.s * vk.col(c.segment + 1) -
+                            c.velocity;
+          const Vec3 vt = vrel - c.normal.dot(vrel) * c.normal;
+          const double slip = vt.norm();
+          const double eps = p_.contact_friction_speed;
+          const double muN = p_.contact_friction * N;
+          // Tangent of mu N tanh(|vt|/eps) vt/|vt|: sech^2/eps along the slip, the secant
+          // tanh(|vt|/eps)/|vt| across it (both mu N/eps at rest). The secant along the slip
+          // too would hold a sliding tether back at the creep speed step after step.
+          if (slip > 1e-9 * eps) {
+            const Vec3 e = vt / slip;
+            const double th = std::tanh(slip / eps);
+            const Mat3 ee = e * e.transpose();
+            B += h * muN * ((1 - th * th) / eps * ee + th / slip * (I - nn - ee));
+          } else {
+            B += h * muN / eps * (I - nn);
+          }
+        }
+        const int j = c.segment;
+        const double wa = 1 - c.s, wb = c.s;
+        const bool d0 = Dynamic(j), d1 = Dynamic(j + 1);
+        if (d0) A.D(j - 1) += (wa * wa) * B;
+        if (d1) A.D(j) += (wb * wb) * B;
+        if (d0 && d1) A.L1(j) += (wa * wb) * B;
+      }
+    }
+    if (A.Factor() >= 0) return false;
+    A.Solve(w.rhs);
+    ++stats->newton_iterations;
+    return true;
+  };
+  // A failed factorisation leaves NaN behind for the divergence check to report.
+  auto fail = [&]() {
+    vk.col(1).setConstant(NAN);
+    x = xk;
+    v = vk;
+    return true;  // nothing to retry
+  };
+
+  // The iterate xk, vk just moved by a full Newton step from the iterate the matrix was
+  // assembled at (whose segment lengths, tangents and tensions are still in w.l, t, w.T): was
+  // the linearisation right? Not if a segment changed between slack (or compressed) and taut:
+  // the law changes at l = L0 (from nothing or EAc to EA). Nor if segments turned so far that
+  // the linearisation missed tension: it took each taut segment's new length as
+  // l + t . d(dx), along its tangent at the start; a segment that turns by theta in the step
+  // is longer than that by about l theta^2/2. Where that would exceed kLinearisationTolerance
+  // of the largest tension (or a microstrain), the step was too long for the linearisation.
+  // (Without this, the fixed line at 160 segments and 50 ms steps went wrong by 3.6 kN RMS,
+  // not 60 N.)
+  const double L0sq = L0_ * L0_;
+  auto linearisation_held = [&]() {
+    for (int j = 0; j < N_; ++j) {
+      if (((xk.col(j + 1) - xk.col(j)).squaredNorm() > L0sq) != (w.l[j] > L0_)) return false;
+    }
+    // Friction saturates over the slip speed eps: where the slip of a contact changed the
+    // friction's tanh by more than 0.1 in the full Newton step just taken (rhs still holds it),
+    // the linearisation was not good for it (a tether starting to slide).
+    if (Has(kContact) && next.contacts && p_.contact_friction > 0) {
+      const ContactSet& set = *next.contacts;
+      const double eps = p_.contact_friction_speed;
+      for (int k = 0; k < set.count; ++k) {
+        const ContactPoint& c = set.points[k];
+        auto node_v = [&](int i, bool after) -> Vec3 {
+          if (after || !Dynamic(i)) return vk.col(i);
+          return vk.col(i) - rhs.col(i - 1);
+        };
+        auto slip = [&](bool after) {
+          const Vec3 vr = (1 - c.s) * node_v(c.segment, after) +
+                          c.s * node_v(c.segment + 1, after) - c.velocity;
+          return (vr - c.normal.dot(vr) * c.normal).norm();
+        };
+        if (std::abs(std::tanh(slip(true) / eps) - std::tanh(slip(false) / eps)) > 0.1) {
+          return false;
+        }
+      }
+    }
+    if (!Has(kAxial)) return true;
+    double T_max = 0, missed = 0;
+    for (int j = 0; j < N_; ++j) {
+      T_max = std::max(T_max, w.T[j]);
+      if (!(w.l[j] > L0_)) continue;
+      const Vec3 d = xk.col(j + 1) - xk.col(j);
+      missed = std::max(missed, p_.EA / L0_ * (d.norm() - t.col(j).dot(d)));
+    }
+    return missed <= std::max(kLinearisationTolerance * T_max, 1e-6 * p_.EA);
+  };
+
+  // First iteration: the linearly implicit step.
+  double err = 0;
+  double phi = residual(&err);
+  if (!solve()) return fail();
+  for (int i = 1; i <= nu; ++i) vk.col(i) += rhs.col(i - 1);
+  place();
+  if (linearisation_held()) {
+    x = xk;
+    v = vk;
+    return true;
+  }
+
+  // Semismooth Newton with a line search on phi, until a full Newton step holds its
+  // linearisation as above, or the velocity error is below kNewtonTolerance of the step's
+  // largest velocity change. The round-off floor: the net force at a node is a sum of terms up
+  // to the largest tension or weight, each exact to ~1e-16 of itself.
+  double dv_max = 0, W_max = 0, m_min = INFINITY, T_max = 0;
+  for (int i = 1; i <= nu; ++i) {
+    dv_max = std::max(dv_max, (vk.col(i) - v.col(i)).squaredNorm());
+    W_max = std::max(W_max, weight_.col(i).norm());
+    m_min = std::min(m_min, mass_(i));
+  }
+  for (int j = 0; j < N_; ++j) T_max = std::max(T_max, w.T[j]);
+  const double tolerance =
+      kNewtonTolerance * std::sqrt(dv_max) + 1e-12 * h * (2 * T_max + W_max) / m_min;
+  start.discrete = true;
+  phi = residual(&err);
+  newton = true;
+  for (int iter = 1; err > tolerance; ++iter) {
+    if (iter == kMaxNewton) return false;
+    if (!solve()) return fail();
+    dv = rhs;
+    for (int i = 1; i <= nu; ++i) vb.col(i - 1) = vk.col(i);
+    for (int i = 1; i <= nu; ++i) vk.col(i) += dv.col(i - 1);
+    place();
+    if (linearisation_held()) break;
+    // Backtracking (Armijo, sigma = 1e-4): phi(alpha) <= (1 - 2 sigma alpha) phi(0), the
+    // directional derivative of phi along an exact Newton step being -2 phi(0).
+    double alpha = 1, trial = 0;
+    for (;;) {
+      trial = residual(&err);
+      if (trial <= (1 - 2e-4 * alpha) * phi) break;
+      alpha *= 0.5;
+      if (alpha < kMinLineSearchStep) return false;
+      for (int i = 1; i <= nu; ++i) vk.col(i) = vb.col(i - 1) + alpha * dv.col(i - 1);
+    }
+    phi = trial;
+  }
+  x = xk;
+  v = vk;
+  return true;
+}
+
+// An implicit step whose Newton iteration did not settle is redone as two half steps (the
+// ends at the midpoint from the same Hermite curve), down to 1/2^kMaxHalvings of the step;
+// at that depth the last iterate is accepted.
+void Tether::ImplicitStepAdaptive(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
+                                  int depth, double* work, StepStatus* stats,
+                                  double impulse_weight) const {
+  constexpr int kMaxHalvings = 8;
+  Work w(work, N_);
+  const int n = N_ + 1;
+  Nodes xs(w.xs, 3, n), vs(w.vs, 3, n);
+  xs = x;
+  vs = v;
+  const bool converged = ImplicitStep(x, v, now, next, h, work, stats);
+  if (converged || depth == kMaxHalvings) {
+    if (!converged) ++stats->stalled_steps;
+    // Backward Euler: M (v+ - v) = h f(x+, v+), so the impulse is h times the final force.
+    AccumulateContactImpulse(x.data(), v.data(), next, impulse_weight * h, false);
+    return;
+  }
+  ++stats->halvings;
+  x = xs;
+  v = vs;
+  const Ends mid = Interpolate(now, next, h, 0.5);
+  ImplicitStepAdaptive(x, v, now, mid, h / 2, depth + 1, work, stats, impulse_weight);
+  ImplicitStepAdaptive(x, v, mid, next, h / 2, depth + 1, work, stats, impulse_weight);
+}
+
+// Two-stage, stiffly accurate, L-stable SDIRK of order 2 (Alexander, SIAM J. Numer. Anal. 14,
+// 1977), gamma = 1 - 1/sqrt(2), on y = (x, v), y' = F(y) = (v, a(x, v)):
+//   Y1 = y + gamma h F(Y1),   y+ = Y2 = y + (1 - gamma) h F(Y1) + gamma h F(Y2).
+// Both stages are backward-Euler steps of size gamma h: the first from y (ends at t + gamma h),
+// the second from y~ = y + (1 - gamma)/gamma (Y1 - y), i.e. x~ = x + (1 - gamma) h V1,
+// v~ = v + (1 - gamma)/gamma (V1 - v) (ends at t + h). Backward Euler damps a mode of frequency
+// w by about w h/2 per radian, which at the vehicle's step is as much as the tether's own
+// damping of its first axial modes; this scheme's error is O(h^2) and its damping O((w h)^3),
+// and it still removes the unresolved axial modes (L-stable).
+void Tether::Sdirk2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
+                        double* work, StepStatus* stats) const {
+  constexpr double kGamma = 0.29289321881345247560;  // 1 - 1/sqrt(2)
+  Work w(work, N_);
+  const int n = N_ + 1;
+  Nodes x0(w.x0, 3, n), v0(w.v0, 3, n);
+  x0 = x;
+  v0 = v;
+  const Ends mid = Interpolate(now, next, h, kGamma);
+  // A stage whose Newton iteration does not settle (a segment switching between slack and
+  // taut) makes the extrapolation to y~ below unreliable (it amplifies Y1 - y by 2.4): such a
+  // step is taken by backward Euler instead, retried in halves as the implicit scheme does.
+  auto fall_back = [&]() {
+    x = x0;
+    v = v0;
+    ImplicitStepAdaptive(x, v, now, next, h, 0, work, stats);
+  };
+  if (!ImplicitStep(x, v, now, mid, kGamma * h, work, stats)) return fall_back();
+  // Contact impulse: y+ = y + (1 - gamma) h F(Y1) + gamma h F(Y2); the first part is kept
+  // aside until the second stage settles (a fallback replaces both).
+  if (Has(kContact) && mid.contacts) {
+    for (int k = 0; k < mid.contacts->count; ++k) mid.contacts->points[k].stage.setZero();
+    AccumulateContactImpulse(x.data(), v.data(), mid, (1 - kGamma) * h, true);
+  }
+  // x, v hold Y1; form y~ on the dynamic nodes (the ends are set by the next stage).
+  const double a = (1 - kGamma) / kGamma;
+  for (int i = 0; i < n; ++i) {
+    if (!Dynamic(i)) continue;
+    x.col(i) = x0.col(i) + (1 - kGamma) * h * v.col(i);
+    v.col(i) = v0.col(i) + a * (v.col(i) - v0.col(i));
+  }
+  if (!ImplicitStep(x, v, mid, next, kGamma * h, work, stats)) return fall_back();
+  if (Has(kContact) && next.contacts) {
+    for (int k = 0; k < next.contacts->count; ++k) {
+      ContactPoint& c = next.contacts->points[k];
+      c.impulse += c.stage;
+    }
+    AccumulateContactImpulse(x.data(), v.data(), next, kGamma * h, false);
+  }
+}
+
+StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends& to, double dt,
+                           double* work) const {
+  const int n = N_ + 1;
+  Nodes x(xp, 3, n), v(vp, 3, n);
+  StepStatus status;
+  const int steps = SubstepsFor(dt);
+  if (steps == 0) return status;
+  const double h = dt / steps;
+  Ends now = from;
+  PlaceEnds(from, x, v);
+  for (int k = 0; k < steps; ++k) {
+    const Ends next = k + 1 == steps ? to : Interpolate(from, to, dt, double(k + 1) / steps);
+    if (p_.integrator == Integrator::kExplicit) {
+      ExplicitStep(x, v, now, next, h, work);
+    } else if (p_.integrator == Integrator::kRK4) {
+      Rk4Step(x, v, now, next, h, work);
+    } else if (p_.integrator == Integrator::kImplicit2) {
+      Sdirk2Step(x, v, now, next, h, work, &status);
+    } else {
+      ImplicitStepAdaptive(x, v, now, next, h, 0, work, &status);
+    }
+    now = next;
+  }
+  // Divergence: a non-finite value, or a strain no tether survives.
+  for (int i = 0; i < n; ++i) {
+    if (!x.col(i).allFinite() || !v.col(i).allFinite()) {
+      status.ok = false;
+      status.node = i;
+      status.reason = "non-finite position or velocity";
+      return status;
+    }
+  }
+  for (int j = 0; j < N_; ++j) {
+    const double strain = (x.col(j + 1) - x.col(j)).norm() / L0_ - 1;
+    if (strain > p_.max_strain) {
+      status.ok = false;
+      status.node = j + 1;
+      status.reason = "strain " + std::to_string(strain) + " of segment " + std::to_string(j) +
+                      " exceeds max_strain " + std::to_string(p_.max_strain);
+      return status;
+    }
+  }
+  // Energy blow-up: more kinetic energy than the tether could hold physically (an unstable
+  // mode grows geometrically and crosses this long before it overflows to NaN).
+  double kinetic = 0, node_max = -1;
+  int fastest = -1;
+  for (int i = 0; i < n; ++i) {
+    if (!Dynamic(i)) continue;
+    const double e = 0.5 * (mass_(i) + added_(i)) * v.col(i).squaredNorm();
+    kinetic += e;
+    if (e > node_max) node_max = e, fastest = i;
+  }
+  const double bound = kEnergyBlowUp * EnergyBound(from, to);
+  if (kinetic > bound) {
+    status.ok = false;
+    status.node = fastest;
+    status.reason = "kinetic energy " + std::to_string(kinetic) + " J exceeds " +
+                    std::to_string(bound) + " J, " + std::to_string(kEnergyBlowUp) +
+                    " times the most the tether can physically hold";
+  }
+  return status;
+}
+
+// The most energy the tether can hold without diverging [J]: elastic energy at max_strain
+// along its whole length, ½ EA max_strain² L; with compression, every segment shortened to
+// nothing, ½ EAc L; bending energy of a fold at every node,
+// ½ EI (2/L0)² L; the kinetic energy of the whole tether (with added mass) moving with its
+// fastest end plus the current; and the work of its net weight falling its own length.
+double Tether::EnergyBound(const Ends& from, const Ends& to) const {
+  const double L = p_.length;
+  double v = std::max(from.a.vel.norm(), to.a.vel.norm());
+  if (!p_.free_end) v = std::max({v, from.b.vel.norm(), to.b.vel.norm()});
+  if (Has(kCurrent)) v += env_.water.current.norm();
+  const double M = mass_.sum() + added_.sum();
+  double E = 0.5 * p_.EA * p_.max_strain * p_.max_strain * L + 0.5 * M * v * v;
+  if (Has(kBending)) E += 0.5 * p_.EI * (4 / (L0_ * L0_)) * L;
+  if (Has(kCompression)) E += 0.5 * p_.EAc * L;
+  double W = 0;  // [N] net weight, without sign
+  for (int i = 0; i <= N_; ++i) W += weight_.col(i).norm();
+  return E + W * L;
+}
+
+}  // namespace mjtether
