@@ -1,4 +1,4 @@
-# Accuracy/cost work (README "Accuracy and cost"): block-band solver, end reactions from
+# Accuracy/cost work (docs/accuracy_cost.md): block-band solver, end reactions from
 # windows, order of convergence of the implicit schemes. The sweep itself is
 # tools/accuracy_cost.sh (tests/bench/accuracy_cost.cc), not part of CTest.
 add_executable(perf_test perf_test.cc)

@@ -1,6 +1,6 @@
 // Tests of the parts that make the engine fast: the block-band solver, the end reactions from
 // 3-node windows, and the order of convergence of the implicit schemes (which is what the
-// accuracy/cost chart in the README rests on).
+// accuracy/cost chart of docs/accuracy_cost.md rests on).
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -134,7 +134,7 @@ TEST(Reactions, WindowsEqualTheFullEvaluationBitForBit) {
   }
 }
 
-// Order of convergence in time on the fixed comparison line (README "Accuracy and cost"), 10
+// Order of convergence in time on the fixed comparison line (docs/accuracy_cost.md), 10
 // segments, 12 s: RMS of the fairlead tension over the last 6 s against a reference of the same
 // tether stepped by implicit2 at 0.25 ms (its own error, by its order, about 1/16 of the error
 // at 1 ms). Halving the step from 2 to 1 ms divides the error of implicit2 (order 2) by 4.0 and

@@ -5,7 +5,7 @@
 
 #include <mujoco/mujoco.h>
 
-#include "mjtether.h"
+#include <mjtether/mjtether.h>
 
 int main() {
   std::string error;
@@ -17,7 +17,7 @@ int main() {
   mjData* d = mj_makeData(m);  // after LoadModel: sized for the tether state
   const int k = mjtether::FindTether(m, "umbilical");
   while (d->time < 60) {
-    mj_step(m, d);  // plain MuJoCo: the tether acts through mjcb_passive
+    mjtether::Step(m, d);  // the thrust: schedules, then mj_step (the tether acts in mjcb_passive)
     if (auto message = mjtether::CheckDivergence(m, d)) {
       std::fprintf(stderr, "%s\n", message->c_str());
       return 1;
@@ -29,9 +29,9 @@ int main() {
   mj_deleteData(d);
   mjtether::Detach(m);
   mj_deleteModel(m);
-  // The example's check, against an estimate from the declarations alone: without thrust the
-  // ROV drifts with the 0.3 m/s current until the tether catches it (about 45 s) and then
-  // hangs on it, at rest in the current. The tether then holds the vehicle's drag at 0.3 m/s,
+  // The example's check, against an estimate from the declarations alone: the ROV drives
+  // down-current on its surge thrusters until 12.5 s, is caught by the tether, and after the
+  // thrust stops hangs on it, at rest in the 0.3 m/s current. The tether then holds the vehicle's drag at 0.3 m/s,
   // linear 10 * 0.3 + quadratic 100 * 0.3^2 = 12 N (surge), and its net buoyancy,
   // (1025 * 0.049268 - 50) * 9.81 = 4.91 N: the tension at the ROV is about
   // hypot(12, 4.91) = 12.97 N. Tolerance 10%: at 60 s the ROV still rises at up to

@@ -34,7 +34,7 @@ Ends Circling(double t) {
 // the friction is regularised by tanh(v/0.01 m/s), so below that slip speed it holds a
 // tangential force only while moving (measured 1.7 mm/s); every node must be slower than that
 // speed. (No bending: at zero tension, without EAc, the
-// bending shear shortens slack segments instead, see README "Physics".) At rest:
+// bending shear shortens slack segments instead, see docs/physics.md.) At rest:
 // - every node on the seabed sits at the penetration that carries its wet weight,
 //   k delta = w (per length), within 1e-7 m (the nodes at the touchdown carry part of a
 //   segment's weight on tension: they are left out, by requiring both neighbours on the bed);

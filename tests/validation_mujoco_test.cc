@@ -1,5 +1,5 @@
 // Validation cases that involve a body, through MuJoCo: a tip load, an end moment, a body
-// sinking with a tether, a snap load. Each records its rows of the README's validation table.
+// sinking with a tether, a snap load. Each records its rows of the validation table (docs/validation.md).
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>

@@ -1,5 +1,5 @@
 // Validation of the tether engine against closed forms and published solutions (no MuJoCo).
-// Each test records its rows of the README's validation table (validation_record.h); the
+// Each test records its rows of the validation table (docs/validation.md) (validation_record.h); the
 // cases that need a body are in validation_mujoco_test.cc.
 //
 // Statics are solved by time stepping with the implicit (backward Euler) integrator at a large

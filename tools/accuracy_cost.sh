@@ -5,7 +5,7 @@
 #                       integrator, segments, step, CPU and wall ms per simulated second, errors,
 #                       Pareto flags (overall, and within its own path and integrator)
 #   accuracy_cost.md    the same as markdown tables, one per scene
-#   accuracy_cost_line.png, accuracy_cost_scenes.png   the charts shown in README.md
+#   accuracy_cost_line.png, accuracy_cost_scenes.png   the charts shown in docs/accuracy_cost.md
 #   machine.txt         where and when it was measured
 # About 11 minutes on the 2-core machine (5 of them the 640-segment reference of the line). Usage:
 #   tools/accuracy_cost.sh [BUILD_DIR] [driver options, e.g. --scenes line]

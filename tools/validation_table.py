@@ -1,11 +1,11 @@
 #!/usr/bin/env python3
-"""Regenerates the README's validation table from the validation tests' own output.
+"""Regenerates the validation table of docs/validation.md from the validation tests' own output.
 
-    python3 tools/validation_table.py [--binary build/tests/validation_test] [--readme README.md]
+    python3 tools/validation_table.py [--binary build/tests/validation_test] [--readme docs/validation.md]
 
 Runs the validation test program with --gtest_output=json, reads the rows each test records
 (properties rowK.case, .reference, .ours, .error, .tolerance, .orders, .segments; see
-tests/validation_record.h) and replaces the text between the two marker lines in the README.
+tests/validation_record.h) and replaces the text between the two marker lines in docs/validation.md.
 A failing test is listed with its status, so the table never hides a failure.
 """
 import argparse
@@ -68,8 +68,8 @@ def main():
     root = os.path.dirname(here)
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--binary", default=os.path.join(root, "build", "tests", "validation_test"))
-    parser.add_argument("--readme", default=os.path.join(root, "README.md"))
-    parser.add_argument("--print", action="store_true", help="print the table, leave the README")
+    parser.add_argument("--readme", default=os.path.join(root, "docs", "validation.md"))
+    parser.add_argument("--print", action="store_true", help="print the table, leave the file")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         out = os.path.join(tmp, "validation.json")
