@@ -86,9 +86,14 @@ class Tether {
   // Doubles of scratch memory that Advance, ComputeForces and Reactions need.
   int WorkspaceSize() const;
 
-  // Largest stable step of the explicit scheme [s]: 2/omega_max with the highest natural
-  // frequency estimated from axial stiffness, bending, seabed stiffness and the node masses,
-  // reduced for damping (see tether.cc); with integrator=rk4, the limit of RK4 (about 2.8/w).
+  // Stability limit of the explicit scheme [s]: 2/omega_max with the highest natural
+  // frequency bounded node by node from axial stiffness, bending, seabed and contact
+  // stiffness and the node masses, reduced for damping (see tether.cc); with integrator=rk4,
+  // the limit of RK4 (about 2.8/w).
+  double ExplicitStabilityLimit() const { return explicit_limit_; }
+  // The step the explicit schemes take [s]: the limit times the safety factor 0.8
+  // (kExplicitSafety, src/detail/work.h), which covers the geometric stiffness T/l and drag
+  // that the bound leaves out.
   double ExplicitStableStep() const { return explicit_dt_; }
   // Number of tether steps to cover dt [s] with the configured integrator.
   int SubstepsFor(double dt) const;
@@ -191,6 +196,7 @@ class Tether {
   double kn_ = 0, kt_ = 0;      // [kg/m^2] 1/2 rho Cdn d, 1/2 rho Cdt pi d (per length)
   double seabed_k_ = 0, seabed_c_ = 0;  // [N/m^2], [N s/m^2] per length
   double contact_k_ = 0, contact_c_ = 0;  // [N/m^2], [N s/m^2] per length
+  double explicit_limit_ = 0;   // [s]
   double explicit_dt_ = 0;      // [s]
   Eigen::VectorXd mass_;        // [kg] (n) dry lumped mass
   Eigen::VectorXd added_;       // [kg] (n) normal added mass Can rho A l_i
