@@ -120,7 +120,7 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
   // seabed k l_i and a contact point k L0. Damping (internal, seabed, friction, contact) per
   // node likewise; with damping ratio z, symplectic Euler is stable up to 2/w (sqrt(1+z^2) - z)
   // (the trace and determinant conditions of its 2x2 step matrix), RK4 up to Rk4StableStep.
-  // On the reference scenes this is within 3% of the measured limit (tests/stable_step_test.cc;
+  // On the reference scenes the measured limit is 0.98-1.06 times this (tests/stable_step_test.cc;
   // a step beyond it does not always blow up: the slack clamp T >= 0 bounds the unstable
   // highest mode, and the run goes on with tensions tens of percent wrong).
   c.explicit_limit_ = INFINITY;  // no dynamic node (one segment between two sites)
