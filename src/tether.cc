@@ -144,6 +144,13 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
     if (c.Has(kContact)) rate += c.contact_c_ * c.L0_ / m_min;
     const double w = std::sqrt(w2);
     const double zeta = rate / (2 * w);
+    c.terms_.w_axial = std::sqrt(4 * (ea / c.L0_) / m_min);
+    if (c.Has(kBending)) {
+      c.terms_.w_bending =
+          std::sqrt((c.Has(kClamp) ? 32 : 16) * params.EI / (c.L0_ * c.L0_ * c.L0_ * mn_min));
+    }
+    if (c.Has(kSeabed)) c.terms_.w_seabed = std::sqrt(c.seabed_k_ * c.L0_ / m_min);
+    c.terms_.rate = rate;
     c.explicit_dt_ = kExplicitSafety * (params.integrator == Integrator::kRK4
                                             ? Rk4StableStep(w, zeta)
                                             : 2 / w * (std::sqrt(1 + zeta * zeta) - zeta));

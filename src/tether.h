@@ -67,6 +67,10 @@ struct StepStatus {
   int newton_iterations = 0;  // linear solves, over all steps and stages
   int halvings = 0;           // steps (or half steps) redone as two halves
   int stalled_steps = 0;      // steps accepted with the Newton iteration not converged
+  // [J] work the tether's force on each attached end did on its site over the advance: the
+  // sum over tether steps of the end node's force (at the step's evaluation) times the end's
+  // displacement. What the tether gave the bodies, for the coupling's work balance.
+  double work_a = 0, work_b = 0;
 };
 
 class Tether {
@@ -127,6 +131,19 @@ class Tether {
   // The most energy the tether can hold physically while its ends move from `from` to `to`
   // [J] (see tether.cc); Advance reports a kinetic energy above 10 times this as divergence.
   double EnergyBound(const Ends& from, const Ends& to) const;
+
+  // Stiffness the end segment presents to a site [N/m]: k_end = EA/L0 (the larger of EA and
+  // EAc when compressed segments push back). The time-step advisor's coupling frequency at an
+  // attached body of effective mass m_eff is sqrt(k_end/m_eff) (docs/coupling.md).
+  double EndStiffness() const;
+
+  // The terms of the explicit stability limit (see Create): highest natural frequencies on the
+  // lightest dynamic node of the axial chain, the bending operator and the seabed [rad/s] (0
+  // when the effect is off), and the damping rate [1/s] (internal, seabed, friction).
+  struct StabilityTerms {
+    double w_axial = 0, w_bending = 0, w_seabed = 0, rate = 0;
+  };
+  const StabilityTerms& stability_terms() const { return terms_; }
 
   // Node masses [kg] (dry, lumped) and net weight force [N] per node.
   double node_mass(int i) const { return mass_[i]; }
@@ -192,6 +209,7 @@ class Tether {
   double seabed_k_ = 0, seabed_c_ = 0;  // [N/m^2], [N s/m^2] per length
   double contact_k_ = 0, contact_c_ = 0;  // [N/m^2], [N s/m^2] per length
   double explicit_dt_ = 0;      // [s]
+  StabilityTerms terms_;
   Eigen::VectorXd mass_;        // [kg] (n) dry lumped mass
   Eigen::VectorXd added_;       // [kg] (n) normal added mass Can rho A l_i
   double damping_per_L0_ = 0;  // [N s/m] internal damping / rest segment length
