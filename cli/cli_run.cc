@@ -252,8 +252,7 @@ int Info(const std::string& path) {
       } else {
         std::cout << "; no limit for " << mjtether::IntegratorName(p.integrator) << " (explicit "
                   << mjtether::kCouplingLimitExplicit << ", rk4 " << mjtether::kCouplingLimitRk4
-                  << ", implicit2 " << mjtether::kCouplingLimitImplicit2
-                  << ")";
+                  << ", implicit2 " << mjtether::kCouplingLimitImplicit2 << ")";
       }
       std::cout << "\n";
     }

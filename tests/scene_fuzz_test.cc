@@ -233,7 +233,7 @@ struct Run {
   // E(t) - E(0) - W_ends(t) over the run [J], and the scale the tolerance is taken from.
   bool balanced = false;
   double excess = -INFINITY, gross = 0, swing = 0;  // [J]
-  int stalled = 0;                                   // implicit steps accepted unconverged
+  int stalled = 0;                                  // implicit steps accepted unconverged
 };
 
 // Energy oracle. The tether's energy E = kinetic (nodes, normal added mass) + potential
@@ -295,7 +295,8 @@ Run Simulate(const Scene& s, double step, double duration = -1) {
     if (run.balanced && xn && vn) {
       const double E = tether->KineticEnergy(xn, vn) + tether->PotentialEnergy(xn, Ends());
       const EndReactions r = GetReactions(m, d, 0);
-      const double P = -(r.force_a.dot(Vec3(vn)) + r.force_b.dot(Vec3(vn + 3 * tether->segments())));
+      const double P =
+          -(r.force_a.dot(Vec3(vn)) + r.force_b.dot(Vec3(vn + 3 * tether->segments())));
       const double t = TetherTime(m, d, 0);
       if (!started) {
         E0 = E, started = true;
@@ -552,9 +553,10 @@ TEST(SceneFuzz, EveryRandomSceneIsRefusedRunsCorrectlyOrDivergesWithACheckedCaus
   for (std::thread& t : pool) t.join();
   mju_user_warning = previous;
 
-  std::printf("scene fuzzer: %zu scenes (seeds %ld..%ld plus the regression seeds, or the list "
-              "given)\n",
-              list.size(), first, first + count - 1);
+  std::printf(
+      "scene fuzzer: %zu scenes (seeds %ld..%ld plus the regression seeds, or the list "
+      "given)\n",
+      list.size(), first, first + count - 1);
   for (const auto& [kind, n] : counts) std::printf("  %5d  %s\n", n, kind.c_str());
   std::printf("known failures (tests/scene_fuzz_known.txt), run but not asserted: %zu\n",
               known_failures.size());

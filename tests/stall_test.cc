@@ -52,13 +52,11 @@ TEST(StallWarning, PrintedOnceAtTheEndOfARunWithStalledSteps) {
   std::string output;
   EXPECT_EQ(RunCli("run " + path + " --duration 1", &output), 0) << output;
   EXPECT_EQ(Count(output, "Newton iteration not converged"), 1) << output;
-  EXPECT_NE(output.find("mjtether: warning: " + path + ": tether 'umbilical': "),
-            std::string::npos)
+  EXPECT_NE(output.find("mjtether: warning: " + path + ": tether 'umbilical': "), std::string::npos)
       << output;
   EXPECT_NE(output.find("implicit step(s) were accepted"), std::string::npos) << output;
   // What to change: the time step, the segments, the integrator.
-  EXPECT_NE(output.find("Reduce <option timestep> (now 0.05 s) or set max_step"),
-            std::string::npos)
+  EXPECT_NE(output.find("Reduce <option timestep> (now 0.05 s) or set max_step"), std::string::npos)
       << output;
   EXPECT_NE(output.find("use fewer segments (now 100)"), std::string::npos) << output;
   EXPECT_NE(output.find("or use integrator=implicit2"), std::string::npos) << output;
