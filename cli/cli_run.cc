@@ -191,6 +191,10 @@ int Run(const RunOptions& opt) {
   }
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // Implicit steps that did not converge: once per run, at its end (README, Numerics).
+  for (const std::string& w : mjtether::StallWarnings(mm, d)) {
+    std::cerr << "mjtether: warning: " << w << "\n";
+  }
   for (OutputFile* f : {&log, &nodes}) {
     if (!f->Commit(&error)) {
       std::cerr << "mjtether: " << error << "\n";
@@ -227,6 +231,31 @@ int Info(const std::string& path) {
               << "    " << (p.integrator == mjtether::Integrator::kRK4 ? "rk4" : "explicit")
               << " stable step " << t->ExplicitStableStep() << " s; "
               << t->SubstepsFor(m->opt.timestep) << " tether step(s) per MuJoCo step\n";
+    // The time-step advisor's limits, each on its own line (docs/coupling.md).
+    const mjtether::Tether::StabilityTerms& st = t->stability_terms();
+    std::cout << "    stable step from: axial omega " << st.w_axial << " rad/s";
+    if (st.w_bending > 0) std::cout << ", bending omega " << st.w_bending << " rad/s";
+    if (st.w_seabed > 0) std::cout << ", seabed omega " << st.w_seabed << " rad/s";
+    std::cout << ", damping rate " << st.rate << " 1/s\n";
+    const double cost = mjtether::EstimatedCostPerSecond(*t, m->opt.timestep);
+    std::cout << "    estimated cost " << cost << " s of CPU per simulated second ("
+              << (cost > 0 ? 1 / cost : 0) << "x real time)\n";
+    for (int end = 0; end < 2; ++end) {
+      const mjtether::CouplingLimit c = mjtether::GetCouplingLimit(m, k, end);
+      if (c.body < 0) continue;
+      std::cout << "    coupling at end " << (end == 0 ? "A" : "B") << " (body '"
+                << BodyName(m, c.body) << "'): k_end = EA/L0 = " << c.k_end
+                << " N/m, m_eff = " << c.m_eff << " kg, omega = " << c.omega
+                << " rad/s, omega h = " << c.omega_h;
+      if (c.applies) {
+        std::cout << "; limit " << c.limit;
+      } else {
+        std::cout << "; no limit for " << mjtether::IntegratorName(p.integrator) << " (explicit "
+                  << mjtether::kCouplingLimitExplicit << ", rk4 " << mjtether::kCouplingLimitRk4
+                  << ", implicit2 " << mjtether::kCouplingLimitImplicit2 << ")";
+      }
+      std::cout << "\n";
+    }
   }
   // Vehicles: net buoyancy and how the added mass is split (README, Vehicles).
   for (int v = 0; v < mjtether::VehicleCount(m); ++v) {

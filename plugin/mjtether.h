@@ -61,6 +61,32 @@ int FindTether(const mjModel* m, const std::string& name);
 std::string TetherName(const mjModel* m, int k);
 // The engine object of tether k (parameters, masses, stability limit).
 const Tether* GetTether(const mjModel* m, int k);
+// The time-step advisor's coupling figures for end `end` (0: A, 1: B) of tether k, when that
+// end is on a body with degrees of freedom (body < 0 otherwise); see docs/coupling.md.
+struct CouplingLimit {
+  int body = -1;         // the body
+  double k_end = 0;      // [N/m] end segment stiffness EA/L0 (max(EA, EAc) with EAc)
+  double m_eff = 0;      // [kg] smallest effective mass at the site, 1/lambda_max(J M^-1 J^T)
+  double omega = 0;      // [rad/s] sqrt(k_end/m_eff)
+  double omega_h = 0;    // [-] omega times <option timestep>
+  double limit = 0;      // [-] omega h refused at load (explicit and rk4 tethers)
+  bool applies = false;  // the limit applies (integrator explicit or rk4)
+};
+CouplingLimit GetCouplingLimit(const mjModel* m, int k, int end);
+// An explicit or rk4 tether on a body whose coupling frequency gives omega h at or above this
+// is refused at load, and warned about above half of it (docs/coupling.md). explicit: on the
+// BlueROV2 case the 1% agreement with a 0.1 ms reference is lost between omega h = 2.1 and
+// 2.4, and the run chatters from 2.8. rk4: an undamped free body yanked by its tether gained 8%
+// of the work done on it at omega h = 0.92 and 0.6% at 0.46. The implicit integrators held 1%
+// up to omega h = 10.6 and gain nothing.
+constexpr double kCouplingLimitExplicit = 2.0;
+constexpr double kCouplingLimitRk4 = 0.8;
+// implicit2 (after the semismooth Newton of issue 11 item 4): within 1% at omega h = 3.36, 3.4%
+// off in position at 10.6 on the same case; refused from 4. implicit has no limit.
+constexpr double kCouplingLimitImplicit2 = 4.0;
+// Estimated CPU time [s] the tether takes per simulated second at MuJoCo step `timestep`, from
+// its tether steps and nodes and the per-node costs measured on this project's machine.
+double EstimatedCostPerSecond(const Tether& t, double timestep);
 // Bodies of ends A and B (-1 for a free end).
 int EndBody(const mjModel* m, int k, int end);
 
@@ -89,6 +115,13 @@ int ContactDropped(const mjModel* m, const mjData* d, int k);
 // a stretched start; README "Initial shape") and what to change; the diverged tether stops
 // applying forces. Otherwise nullopt.
 std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d);
+
+// Steps of an implicit or implicit2 tether accepted with the Newton iteration not converged
+// (StepStatus::stalled_steps: it stalled even at 1/256 of the step and the last iterate was
+// kept), per tether since d was made or reset. For each tether with any, a warning naming the
+// file, the tether, the count, when the first one happened and what to change (the time
+// step, the segments, the integrator); `mjtether run` prints it once at the end of a run.
+std::vector<std::string> StallWarnings(const mjModel* m, const mjData* d);
 
 // Replaces MuJoCo's default error handler (which waits on stdin) by one that prints the
 // message and exits with status 3, and routes warnings to stderr. Idempotent.

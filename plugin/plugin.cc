@@ -1,5 +1,6 @@
 // MuJoCo 2.2 glue: declarations from <custom>, state in mjData::userdata, forces through
 // mjcb_passive.
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -24,18 +25,18 @@ namespace {
 
 // Layout of one tether's block in mjData::userdata.
 enum Slot : int {
-  kInitialized = 0,  // 1 once the initial shape is set (mj_resetData zeroes it)
-  kTime,             // [s] the tether's own time
-  kStatus,           // 0 ok, 1 non-finite, 2 strain beyond max_strain, 3 energy blow-up
-  kBadNode,          // first offending node
-  kBadTime,          // [s] when it diverged
-  kEndA,             // pos(3) vel(3) axis(3) of end A at kTime
-  kEndB = kEndA + 9,  // same for end B
+  kInitialized = 0,     // 1 once the initial shape is set (mj_resetData zeroes it)
+  kTime,                // [s] the tether's own time
+  kStatus,              // 0 ok, 1 non-finite, 2 strain beyond max_strain, 3 energy blow-up
+  kBadNode,             // first offending node
+  kBadTime,             // [s] when it diverged
+  kEndA,                // pos(3) vel(3) axis(3) of end A at kTime
+  kEndB = kEndA + 9,    // same for end B
   kForceA = kEndB + 9,  // last reactions: force A(3), torque A(3), force B(3), torque B(3)
   kTensionA = kForceA + 12,
   kTensionB,
-  kPrevTime,         // [s] the tether's time one call before kTime (== kTime: none yet)
-  kPrevPosA,         // position(3) of end A at kPrevTime (mocap velocity, second order)
+  kPrevTime,  // [s] the tether's time one call before kTime (== kTime: none yet)
+  kPrevPosA,  // position(3) of end A at kPrevTime (mocap velocity, second order)
   kPrevPosB = kPrevPosA + 3,
   kContactImpulse = kPrevPosB + 3,  // [N s] (3) contact impulse on the tether, last advance
   kContactCount = kContactImpulse + 3,  // reactions stored below (contact effect)
@@ -44,13 +45,32 @@ enum Slot : int {
   kContactEndB = kContactEndA + 3,  // [N] (3) the same for end B
   kStartTime = kContactEndB + 3,    // [s] when the initial shape was last set
   kStartStrain,                     // [-] strain of the chord at that moment (0 when not stretched)
-  kHeader,  // x (3 x n) then v (3 x n) follow, then with contact `capacity` records
+  kStalled,                         // implicit steps accepted unconverged since the start
+  kStalledTime,                     // [s] d->time of the call that first reported one
+  kCoupleA,                         // end A on a body that moves: see CoupleSlot
+  kCoupleB = kCoupleA + 5,
+  kHeader = kCoupleB + 5,  // x (3 x n) then v (3 x n) follow, then with contact `capacity` records
 };
 // A contact reaction record: body, force on it [N] (3), point of application [m] (3), applied
 // at every callback until the next advance replaces them.
 constexpr int kContactRecord = 7;
 
+// Per end attached to a body that moves (docs/coupling.md), from kCoupleA or kCoupleB: the
+// work balance of the coupling, for the chatter check.
+enum CoupleSlot : int {
+  kSpurious = 0,     // [J] energy the end gave the body beyond what the tether lost there
+  kEnergyScale = 1,  // [J] largest kinetic energy of the site + elastic energy of the end seen
+  kBodyWork = 2,     // [J] work the end did on the body (for the message)
+  kCoupleSteps = 3,  // [-] steps checked
+  kCoupleSpare = 4,
+  kCoupleSize = 5,
+};
+
+// Divergence codes in kStatus.
+enum Divergence : int { kNonFinite = 1, kStrain = 2, kKinetic = 3, kChatter = 4 };
+
 struct AttachedTether {
+  AttachedTether(std::string n, Tether t) : name(std::move(n)), tether(std::move(t)) {}
   std::string name;
   Tether tether;
   int site[2] = {-1, -1};  // -1: free end
@@ -59,6 +79,10 @@ struct AttachedTether {
   int offset = 0;                  // start of this tether's block in userdata
   bool contact = false;            // the contact effect is on
   TetherContacts contacts;         // the geoms it may touch (contact_glue.h)
+  // End on a body with degrees of freedom (not the world, not mocap): the body feels the end
+  // force explicitly over its step (docs/coupling.md).
+  bool coupled[2] = {false, false};
+  CouplingLimit limit[2];  // the time-step advisor's figures at load time
 };
 
 // Doubles of mjData stack for one step's contact candidates.
@@ -76,7 +100,19 @@ struct ModelTethers {
   int nuserdata = 0;  // m->nuserdata after Attach, to catch a stale registration
   std::vector<std::string> warnings;  // time-step advisor (see Warnings in mjtether.h)
   Environment env;                    // gravity and water, for the divergence diagnosis
+  int nv = 0;                         // m->nv: the coupling's Jacobian scratch is 6 nv doubles
 };
+
+// Coupling chatter (docs/coupling.md): the energy an end gave its body beyond what the tether
+// lost at that end exceeds this multiple of the largest energy seen at the end (kinetic
+// energy of the site's effective mass plus elastic energy of the end segment). A stable
+// coupling keeps it below about one such energy (the modified energy of symplectic Euler
+// oscillates around the true one); a chatter pumps it every step.
+constexpr double kChatterRatio = 4;
+constexpr double kChatterFloor = 1e-3;  // [J] below this nothing is reported
+// Steps of a run (or since a reset) before the check starts: a chatter persists, a start-up
+// transient (the first steps' tiny energy scale) does not.
+constexpr double kChatterSteps = 50;
 
 // More automatic explicit substeps per MuJoCo step than this is refused at load time: the
 // run would take hours per simulated second (see the time-step advisor in Attach).
@@ -173,8 +209,23 @@ bool Teleported(const AttachedTether& at, const Ends& now, const double* u, doub
   return false;
 }
 
+// The inverse mass W = J M^-1 J^T [1/kg] (3x3) of site s's body at the site, from MuJoCo's
+// factored mass matrix (armature, so the vehicle's added mass, included). jac: 6 nv doubles.
+Mat3 SiteInverseMass(const mjModel* m, mjData* d, int s, double* jac) {
+  const int nv = m->nv;
+  double* J = jac;             // 3 x nv, row-major
+  double* MiJ = jac + 3 * nv;  // 3 x nv: M^-1 J^T, row per direction
+  mj_jacSite(m, d, J, nullptr, s);
+  mj_solveM(m, d, MiJ, J, 3);
+  Mat3 W;
+  for (int a = 0; a < 3; ++a) {
+    for (int b = 0; b < 3; ++b) W(a, b) = mju_dot(J + a * nv, MiJ + b * nv, nv);
+  }
+  return 0.5 * (W + W.transpose());
+}
+
 // One tether at one callback: initialise or advance to d->time, then apply the reactions.
-void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* work) {
+void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* work, double* jac) {
   double* u = d->userdata + at.offset;
   if (u[kStatus] != 0) return;  // diverged: stays inert until reset
   const Tether& tether = at.tether;
@@ -185,7 +236,13 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
   now.a = SiteState(m, d, at, 0, u);
   if (!free_end) now.b = SiteState(m, d, at, 1, u);
 
+  // The ends' motion over the last step, for the coupling (read before it is overwritten).
+  const Ends before{LoadEnd(u + kEndA), LoadEnd(u + kEndB)};
+  const double step = d->time - u[kTime];
+  bool advanced = false, restarted = false;
+  double given[2] = {0, 0};  // [J] work the tether's end forces did on the sites this advance
   if (u[kInitialized] == 0 || d->time < u[kTime] || Teleported(at, now, u, d->time)) {
+    restarted = true;
     // First call, reset, time went back, or an end was teleported: start again from the
     // declared initial shape.
     tether.InitialShape(now, x, v);
@@ -216,9 +273,9 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
     }
     StepStatus status = tether.Advance(x, v, from, now, dt, work);
     if (!status.ok) {
-      u[kStatus] = status.reason.rfind("strain", 0) == 0    ? 2
-                   : status.reason.rfind("kinetic", 0) == 0 ? 3
-                                                            : 1;
+      u[kStatus] = status.reason.rfind("strain", 0) == 0    ? kStrain
+                   : status.reason.rfind("kinetic", 0) == 0 ? kKinetic
+                                                            : kNonFinite;
       u[kBadNode] = status.node;
       u[kBadTime] = d->time;
       return;
@@ -250,12 +307,19 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
       }
       u[kContactCount] = stored;
     }
+    if (status.stalled_steps > 0) {
+      if (u[kStalled] == 0) u[kStalledTime] = d->time;
+      u[kStalled] += status.stalled_steps;
+    }
+    given[0] = status.work_a;
+    given[1] = status.work_b;
     u[kPrevTime] = u[kTime];
     std::copy(u + kEndA, u + kEndA + 3, u + kPrevPosA);
     std::copy(u + kEndB, u + kEndB + 3, u + kPrevPosB);
     u[kTime] = d->time;
     StoreEnd(now.a, u + kEndA);
     StoreEnd(now.b, u + kEndB);
+    advanced = true;
   }
 
   // Contact reactions of the last advance, at every call until the next one.
@@ -280,6 +344,38 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
       r.force_b += Vec3(u + kContactEndB);
       r.tension_b = r.force_b.norm();
     }
+  }
+  // Ends on bodies that move, explicit and rk4 tethers (the implicit ones damp what a chatter
+  // would pump, docs/coupling.md): the coupling's work balance over the step.
+  // The body received the force applied at the last call along its site's path (trapezoid of
+  // the site velocity, as the body integrates it); the tether gave the work of its own end
+  // force over its steps along the same path. Their difference is energy the coupling made.
+  for (int end = 0; end < 2 && advanced; ++end) {
+    if (!at.coupled[end] || !IsExplicit(tether.params().integrator)) continue;
+    double* c = u + (end == 0 ? kCoupleA : kCoupleB);
+    const EndState& e1 = end == 0 ? now.a : now.b;
+    const EndState& e0 = end == 0 ? before.a : before.b;
+    const Vec3& force = end == 0 ? r.force_a : r.force_b;
+    const Vec3 applied(u + kForceA + (end == 0 ? 0 : 6));
+    const double gained = applied.dot(0.5 * step * (e0.vel + e1.vel));
+    c[kSpurious] += gained - given[end];
+    c[kBodyWork] += gained;
+    c[kCoupleSteps] += 1;
+    const Mat3 W = SiteInverseMass(m, d, at.site[end], jac);
+    const double energy = 0.5 * e1.vel.dot(W.ldlt().solve(e1.vel)) +
+                          force.squaredNorm() / (2 * tether.EndStiffness());
+    c[kEnergyScale] = std::max(c[kEnergyScale], energy);
+    if (c[kCoupleSteps] > kChatterSteps &&
+        c[kSpurious] > kChatterRatio * c[kEnergyScale] + kChatterFloor) {
+      u[kStatus] = kChatter;
+      u[kBadNode] = end == 0 ? 0 : tether.segments();
+      u[kBadTime] = d->time;
+      return;
+    }
+  }
+  if (restarted) {
+    std::fill(u + kCoupleA, u + kCoupleA + kCoupleSize, 0.0);
+    std::fill(u + kCoupleB, u + kCoupleB + kCoupleSize, 0.0);
   }
   double* cache = u + kForceA;
   for (int i = 0; i < 3; ++i) {
@@ -307,7 +403,8 @@ void Passive(const mjModel* m, mjData* d) {
   if (!set) return;
   mjMARKSTACK;
   double* work = mj_stackAlloc(d, set->work_size);
-  for (const AttachedTether& at : set->tethers) Evaluate(m, d, at, work);
+  double* jac = mj_stackAlloc(d, 6 * std::max(set->nv, 1));
+  for (const AttachedTether& at : set->tethers) Evaluate(m, d, at, work, jac);
   mjFREESTACK;
 }
 
@@ -617,6 +714,103 @@ std::string Diagnose(const mjModel* m, const mjData* d, const Environment& env,
   return "";
 }
 
+// Degrees of freedom of the bodies between b and the world (a body without joints welded to a
+// moving parent moves with it).
+int DofsAbove(const mjModel* m, int b) {
+  int n = 0;
+  for (int p = m->body_parentid[b]; p > 0; p = m->body_parentid[p]) n += m->body_dofnum[p];
+  return n;
+}
+
+// Estimated CPU time of a tether per simulated second [s], from the substeps and the node
+// count, with the costs per node and tether step measured on this project's machine (README,
+// Accuracy and cost: explicit 25 ns, rk4 96 ns, implicit 136 ns per node and step at 80
+// segments; implicit2 two implicit solves).
+double CostPerSecond(const Tether& t, double timestep) {
+  static constexpr double kNsPerNodeStep[] = {25e-9, 136e-9, 272e-9, 96e-9};  // Integrator order
+  const int steps = t.SubstepsFor(timestep);
+  return steps / timestep * t.nodes() * kNsPerNodeStep[static_cast<int>(t.params().integrator)];
+}
+
+// The coupling part of the time-step advisor (docs/coupling.md): for each end on a free body,
+// the coupling frequency omega = sqrt(k_end / m_eff), k_end = EA/L0, m_eff = 1/lambda_max(W)
+// the smallest effective mass of the body at the site (W = J M^-1 J^T at the model's initial
+// configuration). An explicit coupling (coupling=explicit, or MuJoCo's RK4, with which the
+// implicit end is not available) is refused at omega h >= its limit and warned about above
+// half of it. Also warns where automatic substeps make a tether slower than real time.
+bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
+  const double h = m->opt.timestep;
+  mjData* d = nullptr;
+  std::vector<double> jac(6 * std::max(m->nv, 1));
+  bool ok = true;
+  for (AttachedTether& at : set->tethers) {
+    const Tether& t = at.tether;
+    const std::string where = set->source + ": <text name=\"tether:" + at.name + "\">: ";
+    // Automatic substeps slower than real time: name the cheaper setting.
+    const TetherParams& p = t.params();
+    if (IsExplicit(p.integrator) && p.substeps == 0 && p.max_step == 0) {
+      const double cost = CostPerSecond(t, h);
+      if (cost > 1) {
+        std::ostringstream s;
+        s << where << "integrator=" << IntegratorName(p.integrator) << " takes " << t.SubstepsFor(h)
+          << " substeps per MuJoCo step (stable step " << t.ExplicitStableStep() << " s) on "
+          << t.nodes() << " nodes: about " << cost
+          << " s of CPU per simulated second, slower than real "
+          << "time; integrator=implicit takes one step per MuJoCo step (about "
+          << t.nodes() * 136e-9 / h << " s)";
+        set->warnings.push_back(s.str());
+      }
+    }
+    for (int end = 0; end < 2; ++end) {
+      if (!at.coupled[end]) continue;
+      if (!d) {
+        d = mj_makeData(m);
+        mj_kinematics(m, d);
+        mj_comPos(m, d);
+        mj_crb(m, d);
+        mj_factorM(m, d);
+      }
+      const Mat3 W = SiteInverseMass(m, d, at.site[end], jac.data());
+      const double lambda = Eigen::SelfAdjointEigenSolver<Mat3>(W).eigenvalues().maxCoeff();
+      CouplingLimit& c = at.limit[end];
+      c.body = at.body[end];
+      c.k_end = t.EndStiffness();
+      c.m_eff = 1 / lambda;
+      c.omega = std::sqrt(c.k_end * lambda);
+      c.omega_h = c.omega * h;
+      c.limit = p.integrator == Integrator::kRK4        ? kCouplingLimitRk4
+                : p.integrator == Integrator::kExplicit  ? kCouplingLimitExplicit
+                : p.integrator == Integrator::kImplicit2 ? kCouplingLimitImplicit2
+                                                         : 0;
+      c.applies = c.limit > 0;
+      if (!c.applies) continue;
+      const char* body = mj_id2name(m, mjOBJ_BODY, c.body);
+      std::ostringstream s;
+      s << "integrator=" << IntegratorName(p.integrator) << " with end " << (end == 0 ? "A" : "B")
+        << " on body '" << (body ? body : "?") << "': coupling omega h = " << c.omega_h
+        << " (omega = sqrt(k_end/m_eff) = sqrt(" << c.k_end << " N/m / " << c.m_eff
+        << " kg) = " << c.omega << " rad/s, <option timestep> " << h << " s), limit " << c.limit
+        << (p.integrator == Integrator::kImplicit2
+                ? "; use integrator=implicit (measured within 1% at omega h 10.6), or <option "
+                : "; use integrator=implicit (stable at any omega h measured) or implicit2 (up "
+                  "to omega h 4), or <option ")
+        << "timestep> <= "
+        << c.limit / c.omega << " s, or fewer segments or a smaller EA";
+      if (c.omega_h >= c.limit) {
+        *error = where + s.str();
+        ok = false;
+        break;
+      }
+      if (c.omega_h >= 0.5 * c.limit) {
+        set->warnings.push_back(where + s.str() + " (above half the limit: may chatter)");
+      }
+    }
+    if (!ok) break;
+  }
+  if (d) mj_deleteData(d);
+  return ok;
+}
+
 }  // namespace
 
 void InstallErrorHandlers() {
@@ -656,6 +850,7 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
   auto set = std::make_unique<ModelTethers>();
   set->source = source;
   set->env = env;
+  std::string message_for_coupling;
   int offset = m->nuserdata;
   for (int i = 0; i < m->ntext; ++i) {
     const std::string name = TextName(m, i);
@@ -680,7 +875,7 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
                               "\">: EI > 0 without EAc: slack segments can shorten under "
                               "bending; declare EAc (e.g. EAc = EA) for zero-tension loops");
     }
-    AttachedTether at{name.substr(7), *tether};
+    AttachedTether at(name.substr(7), *tether);
     at.contact = (tether->params().effects & kContact) != 0;
     const std::string sites[2] = {decl->site_a, decl->site_b};
     for (int end = 0; end < 2; ++end) {
@@ -691,6 +886,10 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
       }
       at.body[end] = m->site_bodyid[at.site[end]];
       at.mocap[end] = MovedByMocap(m, at.body[end]);
+      // A body that moves under forces: one with degrees of freedom (weld-rooted bodies
+      // without joints have none).
+      at.coupled[end] = at.body[end] > 0 && !at.mocap[end] &&
+                        m->body_dofnum[at.body[end]] + DofsAbove(m, at.body[end]) > 0;
       // A free body at a tether end in water gets buoyancy, drag and current only from a
       // vehicle: declaration; without one it is dry apart from the tether.
       const int carrier = FreeCarrier(m, at.body[end]);
@@ -753,8 +952,14 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
   bool vehicles = false;
   if (!AttachVehicles(m, source, env, &offset, &vehicles, error)) return false;
   if (set->tethers.empty() && !vehicles) return true;
+  // The coupling advisor, with the vehicles' added mass already in the armature.
+  if (!AdviseCoupling(m, set.get(), &message_for_coupling)) {
+    if (error) *error = message_for_coupling;
+    return false;
+  }
+  set->nv = m->nv;
   m->nuserdata = offset;
-  m->nstack += set->work_size + 64;
+  m->nstack += set->work_size + 6 * std::max(m->nv, 1) + 64;
   set->nuserdata = m->nuserdata;
   {
     std::unique_lock<std::shared_mutex> lock(g_mutex);
@@ -845,6 +1050,18 @@ const Tether* GetTether(const mjModel* m, int k) {
   return &set->tethers[k].tether;
 }
 
+CouplingLimit GetCouplingLimit(const mjModel* m, int k, int end) {
+  const ModelTethers* set = Lookup(m);
+  if (!set || k < 0 || k >= static_cast<int>(set->tethers.size()) || end < 0 || end > 1) {
+    return {};
+  }
+  return set->tethers[k].limit[end];
+}
+
+double EstimatedCostPerSecond(const Tether& t, double timestep) {
+  return CostPerSecond(t, timestep);
+}
+
 int EndBody(const mjModel* m, int k, int end) {
   const ModelTethers* set = Lookup(m);
   if (!set || k < 0 || k >= static_cast<int>(set->tethers.size()) || end < 0 || end > 1) {
@@ -907,6 +1124,29 @@ int ContactDropped(const mjModel* m, const mjData* d, int k) {
   return static_cast<int>(u[kContactDropped]);
 }
 
+std::vector<std::string> StallWarnings(const mjModel* m, const mjData* d) {
+  std::vector<std::string> out;
+  const ModelTethers* set = Lookup(m);
+  if (!set) return out;
+  for (const AttachedTether& at : set->tethers) {
+    const double* u = d->userdata + at.offset;
+    if (u[kStalled] <= 0) continue;
+    const Tether& t = at.tether;
+    std::ostringstream s;
+    s << set->source << ": tether '" << at.name << "': " << static_cast<long long>(u[kStalled])
+      << " " << IntegratorName(t.params().integrator)
+      << " step(s) were accepted with the Newton iteration not converged (it stalled even at "
+         "1/256 of the step), the first in the step to t = "
+      << u[kStalledTime] << " s; the tether's motion near then may be wrong. Reduce <option "
+      << "timestep> (now " << m->opt.timestep << " s) or set max_step, use fewer segments (now "
+      << t.segments() << "), or use integrator="
+      << (t.params().integrator == Integrator::kImplicit2 ? "implicit" : "implicit2")
+      << " or explicit (automatic substeps)";
+    out.push_back(s.str());
+  }
+  return out;
+}
+
 std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d) {
   const ModelTethers* set = Lookup(m);
   if (!set) return std::nullopt;
@@ -915,6 +1155,25 @@ std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d) {
     if (u[kStatus] == 0) continue;
     const Tether& t = at.tether;
     std::ostringstream s;
+    if (u[kStatus] == kChatter) {
+      const int end = u[kBadNode] == 0 ? 0 : 1;
+      const CouplingLimit& c = at.limit[end];
+      const double* cp = u + (end == 0 ? kCoupleA : kCoupleB);
+      const char* body = mj_id2name(m, mjOBJ_BODY, at.body[end]);
+      s << set->source << ": tether '" << at.name << "': coupling chatter at end "
+        << (end == 0 ? "A" : "B") << " on body '" << (body ? body : "?")
+        << "' at t = " << u[kBadTime] << " s: the end gave the body " << cp[kSpurious]
+        << " J more than the tether lost there (the work balance does not explain it; "
+        << "largest energy at the end " << cp[kEnergyScale] << " J, " << cp[kCoupleSteps]
+        << " steps). The end segment's "
+        << "stiffness EA/L0 = " << c.k_end << " N/m on the body's effective mass " << c.m_eff
+        << " kg gives omega h = " << c.omega_h << " at <option timestep> " << m->opt.timestep
+        << " s. ";
+      // (Checked for explicit and rk4 tethers only.)
+      s << "Use integrator=implicit or implicit2, or <option timestep> <= " << c.limit / c.omega
+        << " s.";
+      return s.str();
+    }
     s << set->source << ": tether '" << at.name << "' diverged at t = " << u[kBadTime]
       << " s at node " << static_cast<int>(u[kBadNode]) << " of " << t.nodes() << " ("
       << (u[kStatus] == 2   ? "strain beyond max_strain"

@@ -361,6 +361,10 @@ EndReactions Tether::Reactions(const double* xp, const double* vp, const Ends& e
   return r;
 }
 
+double Tether::EndStiffness() const {
+  return (Has(kCompression) ? std::max(p_.EA, p_.EAc) : p_.EA) / L0_;
+}
+
 // Tension only: a compressed segment (compression effect) reads 0, like a slack one.
 void Tether::Tensions(const double* xp, const double* vp, double* T) const {
   ConstNodes x(xp, 3, N_ + 1), v(vp, 3, N_ + 1);

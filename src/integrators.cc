@@ -569,6 +569,11 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
     } else {
       ImplicitStepAdaptive(x, v, now, next, h, 0, work, &status);
     }
+    // Work of the end forces over the step: the integrator's last force evaluation (explicit:
+    // start of the step; implicit: the last Newton iterate; rk4: the last stage).
+    const ConstNodes f(Work(work, N_).f, 3, n);
+    status.work_a += f.col(0).dot(next.a.pos - now.a.pos);
+    if (!p_.free_end) status.work_b += f.col(N_).dot(next.b.pos - now.b.pos);
     now = next;
   }
   // Divergence: a non-finite value, or a strain no tether survives.

@@ -132,12 +132,16 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
       const double m = c.mass_(i), mn = c.mass_(i) + c.added_(i);  // [kg]
       double w2 = 2 * segments_at_node * (ea / c.L0_) / m;           // [1/s^2]
       double rate = 0;                                               // [1/s] damping / mass
+      c.terms_.w_axial = std::max(c.terms_.w_axial, std::sqrt(w2));
       if (c.Has(kBending)) {
         const double row = segments_at_node == 1 ? 4 : (c.Has(kClamp) ? 32 : 16);
-        w2 += row * params.EI / (c.L0_ * c.L0_ * c.L0_ * mn);
+        const double wb2 = row * params.EI / (c.L0_ * c.L0_ * c.L0_ * mn);
+        w2 += wb2;
+        c.terms_.w_bending = std::max(c.terms_.w_bending, std::sqrt(wb2));
       }
       if (c.Has(kSeabed)) {
         w2 += c.seabed_k_ * c.share_(i) / m;
+        c.terms_.w_seabed = std::max(c.terms_.w_seabed, std::sqrt(c.seabed_k_ * c.share_(i) / m));
         rate += c.seabed_c_ * c.share_(i) / m;
         const double mu = std::max(env.water.seabed_friction, env.water.seabed_friction_axial);
         rate += mu * c.weight_.col(i).norm() / (env.water.seabed_friction_speed * m);
@@ -148,6 +152,7 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
         rate += c.contact_c_ * c.L0_ / m;
       }
       if (c.Has(kDamping)) rate += 2 * segments_at_node * (params.damping / c.L0_) / m;
+      c.terms_.rate = std::max(c.terms_.rate, rate);
       const double w = std::sqrt(w2);
       const double zeta = rate / (2 * w);
       const double h = params.integrator == Integrator::kRK4

@@ -67,6 +67,10 @@ struct StepStatus {
   int newton_iterations = 0;  // linear solves, over all steps and stages
   int halvings = 0;           // steps (or half steps) redone as two halves
   int stalled_steps = 0;      // steps accepted with the Newton iteration not converged
+  // [J] work the tether's force on each attached end did on its site over the advance: the
+  // sum over tether steps of the end node's force (at the step's evaluation) times the end's
+  // displacement. What the tether gave the bodies, for the coupling's work balance.
+  double work_a = 0, work_b = 0;
 };
 
 class Tether {
@@ -133,6 +137,20 @@ class Tether {
   // [J] (see tether.cc); Advance reports a kinetic energy above 10 times this as divergence.
   double EnergyBound(const Ends& from, const Ends& to) const;
 
+  // Stiffness the end segment presents to a site [N/m]: k_end = EA/L0 (the larger of EA and
+  // EAc when compressed segments push back). The time-step advisor's coupling frequency at an
+  // attached body of effective mass m_eff is sqrt(k_end/m_eff) (docs/coupling.md).
+  double EndStiffness() const;
+
+  // The terms of the explicit stability limit (see Create), each the largest over the dynamic
+  // nodes of its node-by-node bound: natural frequencies of the axial chain, the bending
+  // operator and the seabed [rad/s] (0 when the effect is off), and the damping rate [1/s]
+  // (internal, seabed, friction, contact).
+  struct StabilityTerms {
+    double w_axial = 0, w_bending = 0, w_seabed = 0, rate = 0;
+  };
+  const StabilityTerms& stability_terms() const { return terms_; }
+
   // Node masses [kg] (dry, lumped) and net weight force [N] per node.
   double node_mass(int i) const { return mass_[i]; }
   Vec3 node_weight(int i) const { return weight_.col(i); }
@@ -198,6 +216,7 @@ class Tether {
   double contact_k_ = 0, contact_c_ = 0;  // [N/m^2], [N s/m^2] per length
   double explicit_limit_ = 0;   // [s]
   double explicit_dt_ = 0;      // [s]
+  StabilityTerms terms_;
   Eigen::VectorXd mass_;        // [kg] (n) dry lumped mass
   Eigen::VectorXd added_;       // [kg] (n) normal added mass Can rho A l_i
   double damping_per_L0_ = 0;  // [N s/m] internal damping / rest segment length

@@ -248,7 +248,7 @@ INSTANTIATE_TEST_SUITE_P(Contact, NoTunnelling,
 
 // ---------------------------------------------------------------------------------------------
 // Resting: a heavy tether lying down a slope of angle alpha (a plane, or the top of a tilted
-// box), held only by friction mu (its upper end on a 50 g frictionless slider along the
+// box), held only by friction mu (its upper end on a 100 g frictionless slider along the
 // slope: the slider runs ahead under its own weight and the first segment goes slack, so the
 // tether below is held by nothing else). Coulomb: it stays when tan(alpha) < mu and slides with
 // acceleration g (sin(alpha) - mu cos(alpha)) when tan(alpha) > mu. Staying is "within the
@@ -267,7 +267,7 @@ TEST_P(Resting, SlidesWhenTanAlphaExceedsMu) {
   const auto [sc, integrator] = GetParam();
   const double mu = 0.3, eps = 0.01, alpha = std::atan(sc.tan_alpha);
   const double g = 9.81, r = 0.01;
-  const double M = 0.05;  // [kg] slider
+  const double M = 0.1;  // [kg] slider (rk4: coupling omega h = 0.63, below its limit 0.8)
   // Downhill direction in the x-z plane, surface normal.
   const Vec3 down(std::cos(alpha), 0, -std::sin(alpha)),
       normal(std::sin(alpha), 0, std::cos(alpha));

@@ -11,29 +11,34 @@
 //   refused      refused at load (exit 2 from the CLI) with a cause this file recomputes from
 //                the scene (an end or the vehicle below the seabed, ends beyond
 //                length x (1 + max_strain), a diameter or segment count out of its threshold,
-//                more than 1e5 explicit substeps);
+//                more than 1e5 explicit substeps, a coupling omega h = sqrt(EA/(L0 (m + a))) h
+//                at the vehicle at or above the advisor's limit for the integrator: explicit 2,
+//                rk4 0.8, implicit2 4, docs/coupling.md);
 //   agrees       runs to the end, every value finite, no MuJoCo warning, and agrees with the
 //                same scene at a 10x smaller MuJoCo step: vehicle position within
 //                max(5 cm, 2% of the span) and the vehicle-end tension averaged over the last
 //                0.2 s within max(0.5 N, 5%) (the criterion for "silently wrong");
+//                and, without a current, the tether's energy never rises above its start by
+//                more than the work its ends did on it (EnergyTolerance, below);
 //   diverged     stops with a divergence message whose cause this file checks: thrust beyond
 //                EA x max_strain, ends pulled beyond length x (1 + max_strain), an end moving
 //                more than half of max_strain L0 per step, an end below the seabed, a stretched
-//                start; or, where the message blames the step, the same scene at a 10x smaller
-//                step runs to the end.
+//                start; a coupling chatter (the run-time work balance) where omega h is at
+//                least half the advisor's limit; or, where the message blames the step, the
+//                same scene at a 10x smaller step runs to the end.
 // Anything else is a failure: a refusal or divergence whose cause does not hold, a scene that
 // should have been refused, a non-finite value, a MuJoCo warning (it resets the data
 // silently), or a run that disagrees with its fine-step self.
 //
-// Seeds listed in tests/scene_fuzz_known.txt fail from the vehicle-tether coupling (omega h
-// >= 1 at the vehicle; fixed on another branch): they run and are counted, but not asserted.
+// Seeds listed in tests/scene_fuzz_known.txt fail for a reason given there (open problems):
+// they run and are counted, but not asserted.
 // Seeds in tests/scene_fuzz_regressions.txt are scenes that a long run once found broken;
 // they always run in addition to the fixed set.
 //
 // Environment: MJTETHER_SCENE_FUZZ_COUNT (default 200), MJTETHER_SCENE_FUZZ_FIRST (first
 // seed, default 1), MJTETHER_SCENE_FUZZ_THREADS (default 2), MJTETHER_SCENE_FUZZ_VERBOSE=1
 // (one line per scene, flushed), MJTETHER_SCENE_FUZZ_XML=1 (print each scene's MJCF instead of
-// running it).
+// running it), MJTETHER_SCENE_FUZZ_SEEDS=a,b,c (only these seeds).
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
 
@@ -224,7 +229,26 @@ struct Run {
   double tension = 0;                               // [N] mean over the last kAverage
   int warnings = 0;
   double duration = kDuration;  // [s] simulated
+  // Energy balance of the tether (scenes without current, see EnergyExcess): the largest
+  // E(t) - E(0) - W_ends(t) over the run [J], and the scale the tolerance is taken from.
+  bool balanced = false;
+  double excess = -INFINITY, gross = 0, swing = 0;  // [J]
+  int stalled = 0;                                  // implicit steps accepted unconverged
 };
+
+// Energy oracle. The tether's energy E = kinetic (nodes, normal added mass) + potential
+// (elastic, bending, net weight; Tether::KineticEnergy, PotentialEnergy) changes by the work
+// its ends do on it, W_ends = integral of -(F_a . v_a + F_b . v_b) dt (F: the reactions on
+// the sites, v: the end nodes' velocities, which are the sites'), minus what drag, internal
+// and seabed damping and friction dissipate (never negative without a current: drag
+// -c|v|v . v <= 0). The seabed's elastic energy is left out of E; it is >= 0 and 0 at the
+// start (the initial shape rests on the seabed), so leaving it out only lowers E(t) - E(0).
+// Hence E(t) - E(0) <= W_ends(t) at every t. Tolerance (EnergyTolerance): W_ends is a
+// trapezoid over the MuJoCo step of a power sampled once per step, whose error on a smooth
+// power is O(h^2) of the gross work; a gain by an instability is not a few percent but grows
+// without bound. A current can put energy in through drag (F . U > 0), so scenes with a
+// current are not balanced.
+double EnergyTolerance(const Run& r) { return 0.05 * (r.gross + r.swing) + 1e-3; }
 
 // The duration that keeps the scene within kBudget node updates at the step of 2 ms.
 double Duration(const mjModel* m) {
@@ -255,6 +279,10 @@ Run Simulate(const Scene& s, double step, double duration = -1) {
       steps - static_cast<int>(std::lround(std::min(kAverage, run.duration / 5) / step));
   double sum = 0;
   int count = 0;
+  const Tether* tether = GetTether(m, 0);
+  run.balanced = s.current.norm() == 0;
+  double E0 = 0, P0 = 0, t0 = 0, W = 0;  // [J], [W], [s], [J]
+  bool started = false;
   for (int k = 0; k < steps; ++k) {
     Step(m, d);
     if (std::optional<std::string> message = CheckDivergence(m, d)) {
@@ -262,11 +290,31 @@ Run Simulate(const Scene& s, double step, double duration = -1) {
       run.message = *message;
       break;
     }
+    const double* xn = NodePositions(m, d, 0);
+    const double* vn = NodeVelocities(m, d, 0);
+    if (run.balanced && xn && vn) {
+      const double E = tether->KineticEnergy(xn, vn) + tether->PotentialEnergy(xn, Ends());
+      const EndReactions r = GetReactions(m, d, 0);
+      const double P =
+          -(r.force_a.dot(Vec3(vn)) + r.force_b.dot(Vec3(vn + 3 * tether->segments())));
+      const double t = TetherTime(m, d, 0);
+      if (!started) {
+        E0 = E, started = true;
+        run.excess = 0;
+      } else {
+        run.gross += 0.5 * (std::abs(P) + std::abs(P0)) * (t - t0);
+        W += 0.5 * (P + P0) * (t - t0);
+        run.excess = std::max(run.excess, E - E0 - W);
+      }
+      run.swing = std::max(run.swing, std::abs(E - E0));
+      P0 = P, t0 = t;
+    }
     if (k >= average_from) sum += GetReactions(m, d, 0).tension_b, ++count;
     if (t_warnings > 0) break;
   }
   run.warnings = t_warnings;
   if (t_warnings > 0) run.message = t_last_warning;
+  run.stalled = static_cast<int>(StallWarnings(m, d).size());
   run.tension = count > 0 ? sum / count : 0;
   const int rov = mj_name2id(m, mjOBJ_BODY, "rov"), tms = mj_name2id(m, mjOBJ_BODY, "tms");
   run.vehicle = Vec3(d->xpos + 3 * rov);
@@ -295,7 +343,16 @@ struct Outcome {
   bool pass = false;
   std::string detail;
   bool shortened = false;  // run for less than kDuration (cost budget)
+  bool stalled = false;    // the 2 ms run had implicit steps accepted unconverged
 };
+
+// The omega h at which the advisor refuses the scene's integrator (0: no limit).
+double CouplingLimitOf(const Scene& s) {
+  if (s.integrator == "explicit") return kCouplingLimitExplicit;
+  if (s.integrator == "rk4") return kCouplingLimitRk4;
+  if (s.integrator == "implicit2") return kCouplingLimitImplicit2;
+  return 0;
+}
 
 // Load refusals whose cause the scene itself confirms.
 Outcome CheckRefusal(const Scene& s, const std::string& error) {
@@ -317,6 +374,12 @@ Outcome CheckRefusal(const Scene& s, const std::string& error) {
   if (Contains(error, "key 'ctrl'") && Contains(error, "[-1e+09, 1e+09]")) {
     return {"refused: thrust schedule beyond its range (1e9 N)", s.thrust > 1e9, error};
   }
+  if (Contains(error, "coupling omega h = ")) {
+    // The advisor's coupling frequency at the vehicle (docs/coupling.md): the site is at the
+    // vehicle's centre of mass, so m_eff = m + the smallest added mass, as in Make.
+    const double limit = CouplingLimitOf(s);
+    return {"refused: coupling omega h >= limit", limit > 0 && s.omega_h >= 0.99 * limit, error};
+  }
   if (Contains(error, "substeps per MuJoCo step")) {
     return {"refused: explicit substeps > 1e5", s.integrator == "explicit" || s.integrator == "rk4",
             error};
@@ -329,14 +392,19 @@ std::string ExpectedRefusal(const Scene& s) {
   if (s.seabed_kind == 3) return "an end below the seabed";
   if (s.b.norm() > 2 * s.length) return "ends beyond length x (1 + max_strain)";
   if (s.L0() < 0.1 * s.diameter) return "segments shorter than d/10";
+  if (CouplingLimitOf(s) > 0 && s.omega_h >= 1.01 * CouplingLimitOf(s)) {
+    return "coupling omega h >= limit";
+  }
   return "";
 }
 
 thread_local bool t_shortened = false;
+thread_local bool t_stalled = false;
 
 Outcome JudgeRuns(const Scene& s) {
   const Run coarse = Simulate(s, kStep);
   t_shortened = coarse.loaded && coarse.duration < kDuration;
+  t_stalled = coarse.stalled > 0;
   if (!coarse.loaded) return CheckRefusal(s, coarse.error);
   if (const std::string expected = ExpectedRefusal(s); !expected.empty()) {
     return {"not refused", false, "expected a refusal: " + expected};
@@ -367,6 +435,11 @@ Outcome JudgeRuns(const Scene& s) {
               s.seabed_kind != 0 && (coarse.vehicle.z() < s.seabed || coarse.tms.z() < s.seabed),
               msg};
     }
+    if (Contains(msg, "coupling chatter")) {
+      // The run-time work balance (docs/coupling.md): only where the advisor warned.
+      return {"diverged: coupling chatter",
+              CouplingLimitOf(s) > 0 && s.omega_h >= 0.5 * CouplingLimitOf(s), msg};
+    }
     if (Contains(msg, "start-up strain")) {
       return {"diverged: stretched start", s.b.norm() > s.length, msg};
     }
@@ -391,13 +464,22 @@ Outcome JudgeRuns(const Scene& s) {
   detail << "position " << dx << " m (tol " << tol_x << "), tension " << coarse.tension << " vs "
          << fine.tension << " N (tol " << tol_T << ")";
   if (dx > tol_x || dT > tol_T) return {"disagrees with 10x smaller step", false, detail.str()};
+  if (coarse.balanced) {
+    detail << "; energy gain beyond the ends' work " << coarse.excess << " J (tol "
+           << EnergyTolerance(coarse) << ")";
+    if (coarse.excess > EnergyTolerance(coarse)) {
+      return {"tether gains energy beyond the work of its ends", false, detail.str()};
+    }
+    return {"agrees with 10x smaller step, energy balanced", true, detail.str()};
+  }
   return {"agrees with 10x smaller step", true, detail.str()};
 }
 
 Outcome Judge(const Scene& s) {
-  t_shortened = false;
+  t_shortened = t_stalled = false;
   Outcome o = JudgeRuns(s);
   o.shortened = t_shortened;
+  o.stalled = t_stalled;
   return o;
 }
 
@@ -427,6 +509,12 @@ TEST(SceneFuzz, EveryRandomSceneIsRefusedRunsCorrectlyOrDivergesWithACheckedCaus
   const std::set<unsigned long long> known = ReadSeeds(MJTETHER_SCENE_FUZZ_KNOWN);
   std::set<unsigned long long> seeds = ReadSeeds(MJTETHER_SCENE_FUZZ_REGRESSIONS);
   for (long k = 0; k < count; ++k) seeds.insert(first + k);
+  // MJTETHER_SCENE_FUZZ_SEEDS="4,136,141": exactly these seeds (to re-check a list).
+  if (const char* only = std::getenv("MJTETHER_SCENE_FUZZ_SEEDS"); only && *only) {
+    seeds.clear();
+    std::istringstream l(only);
+    for (std::string seed; std::getline(l, seed, ',');) seeds.insert(std::stoull(seed));
+  }
   const std::vector<unsigned long long> list(seeds.begin(), seeds.end());
 
   void (*previous)(const char*) = mju_user_warning;
@@ -452,6 +540,7 @@ TEST(SceneFuzz, EveryRandomSceneIsRefusedRunsCorrectlyOrDivergesWithACheckedCaus
       std::lock_guard<std::mutex> lock(mutex);
       ++counts[(o.pass ? "pass  " : "FAIL  ") + o.kind];
       if (o.shortened) ++counts["(of these, run shortened below 1 s by the cost budget)"];
+      if (o.stalled) ++counts["(of these, with stalled implicit steps: warned)"];
       const bool is_known = known.count(s.seed) > 0;
       if (!o.pass && is_known) known_failures.push_back(line.str());
       if (!o.pass && !is_known) failures.push_back(line.str());
@@ -464,8 +553,10 @@ TEST(SceneFuzz, EveryRandomSceneIsRefusedRunsCorrectlyOrDivergesWithACheckedCaus
   for (std::thread& t : pool) t.join();
   mju_user_warning = previous;
 
-  std::printf("scene fuzzer: %zu scenes (seeds %ld..%ld plus %zu regression seeds)\n", list.size(),
-              first, first + count - 1, list.size() - static_cast<size_t>(count));
+  std::printf(
+      "scene fuzzer: %zu scenes (seeds %ld..%ld plus the regression seeds, or the list "
+      "given)\n",
+      list.size(), first, first + count - 1);
   for (const auto& [kind, n] : counts) std::printf("  %5d  %s\n", n, kind.c_str());
   std::printf("known failures (tests/scene_fuzz_known.txt), run but not asserted: %zu\n",
               known_failures.size());
