@@ -23,9 +23,9 @@
 #include "cli_common.h"
 #include "cli_pipe.h"
 #include "cli_plot_columns.h"
+#include "step_check.h"
 #include "mjtether.h"
 #include "render.h"
-#include "step_check.h"
 
 namespace {
 

@@ -28,9 +28,9 @@
 #include "cli_command.h"
 #include "cli_common.h"
 #include "cli_pipe.h"
+#include "step_check.h"
 #include "mjtether.h"
 #include "render.h"
-#include "step_check.h"
 
 namespace {
 
