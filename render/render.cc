@@ -108,6 +108,8 @@ constexpr float kRamp[5][3] = {{0.15f, 0.30f, 1.00f},
 constexpr float kSlack[3] = {0.62f, 0.62f, 0.62f};
 constexpr float kSand[4] = {0.55f, 0.50f, 0.40f, 1.0f};
 constexpr float kArrow[4] = {0.95f, 0.95f, 1.00f, 1.0f};
+constexpr float kSurface[4] = {0.55f, 0.75f, 0.90f, 0.35f};  // translucent water surface
+constexpr float kFog[4] = {0.06f, 0.18f, 0.30f, 1.0f};       // water colour far from the eye
 
 // Background: water, darker with depth (top to bottom of the image).
 constexpr float kWaterTop[3] = {0.16f, 0.36f, 0.52f};
@@ -437,6 +439,19 @@ std::unique_ptr<Renderer> Renderer::Create(mjModel* m, const RenderOptions& opti
   r->cam_.distance = r->follow_distance_;
   r->cam_.azimuth = r->follow_azimuth_;
   r->cam_.elevation = r->top_ ? -90 : kFollowElevation;
+
+  // Water: fog; a surface when a tether end starts within 1 m of z = 0.
+  if (TetherCount(m) > 0 && GetTether(m, 0)->env().wet) {
+    r->wet_ = true;
+    mjData* d0 = mj_makeData(m);
+    mj_forward(m, d0);
+    for (int k = 0; k < TetherCount(m); ++k) {
+      const double* x = NodePositions(m, d0, k);
+      const int n = GetTether(m, k)->nodes();
+      if (x && (std::abs(x[2]) < 1 || std::abs(x[3 * (n - 1) + 2]) < 1)) r->has_surface_ = true;
+    }
+    mj_deleteData(d0);
+  }
 
   // A model plane at the seabed height stands for the seabed; otherwise one is drawn.
   if (TetherCount(m) > 0 && GetTether(m, 0)->env().water.has_seabed) {
@@ -820,6 +835,18 @@ void Renderer::Decorate(const mjModel* m, const mjData* d, double D, bool overla
     }
   }
 
+  // Water surface: a translucent sheet at z = 0 under the reference point, when the scene has
+  // one (a tether end within 1 m of z = 0 at the start).
+  if (has_surface_) {
+    if (mjvGeom* g = NextGeom(&scn_)) {
+      const mjtNum size[3] = {4 * D, 4 * D, 1e-3 * D};
+      const mjtNum pos[3] = {ref.x(), ref.y(), 0};
+      const mjtNum mat[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+      mjv_initGeom(g, mjGEOM_BOX, size, pos, mat, kSurface);
+      FinishDecor(g, &scn_);
+    }
+  }
+
   // Current: an arrow in the top-right rectangle, 0.5 D per m/s, at most 70 % of its width.
   const double speed = w.current.norm();
   const Rect& box = layout_.arrow;
@@ -953,6 +980,15 @@ void Renderer::DrawWater(const Rect& r) {
   gl_->PopAttrib();
 }
 
+// Depth cue in water: linear fog toward the water's colour, from 0.7 D to 4 D from the eye (D
+// the camera's distance to what it looks at).
+void Renderer::Fog(double D) {
+  scn_.flags[mjRND_FOG] = wet_;
+  con_.fogStart = static_cast<float>(0.7 * D);
+  con_.fogEnd = static_cast<float>(4 * D);
+  std::copy(kFog, kFog + 4, con_.fogRGBA);
+}
+
 void Renderer::Render(const mjModel* m, mjData* d, unsigned char* rgb, float* depth) {
   RenderAt(m, d, NextPose(m, d), rgb, depth);
 }
@@ -972,6 +1008,7 @@ void Renderer::RenderAt(const mjModel* m, mjData* d, const CameraPose& pose, uns
   const double D = free_camera ? pose.distance : follow_distance_;
   mjv_updateScene(m, d, &vopt_, nullptr, &cam_, mjCAT_ALL, &scn_);
   Decorate(m, d, D, true);
+  Fog(D);
   const Rect all = {0, 0, opt_.width, opt_.height};
   mjr_render({0, 0, opt_.width, opt_.height}, &scn_, &con_);
   DrawWater(all);
@@ -986,6 +1023,7 @@ void Renderer::RenderAt(const mjModel* m, mjData* d, const CameraPose& pose, uns
     cam.distance = pp.distance;
     mjv_updateScene(m, d, &vopt_, nullptr, &cam, mjCAT_ALL, &scn_);
     Decorate(m, d, pp.distance, false);
+    Fog(pp.distance);
     const Rect& r = layout_.pip;
     const int b = std::max(1, opt_.height / 240);
     mjr_rectangle({r.x - b, r.y - b, r.w + 2 * b, r.h + 2 * b}, 0.9f, 0.9f, 0.9f, 1);

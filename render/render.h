@@ -4,7 +4,9 @@
 //     [0, tension_max] (blue, cyan, green, yellow, red; red also above the scale); a slack
 //     segment (no tension) is grey and half as thick;
 //   - the seabed (a sand-coloured slab at the declared height, unless the model has a plane
-//     there) and an arrow along the current, length proportional to its speed;
+//     there), a translucent water surface at z = 0 when a tether end starts within 1 m of it,
+//     fog toward the water's colour with distance (wet scenes), and an arrow along the current
+//     (top right), length proportional to its speed;
 //   - a HUD: time, the tension at each end of every tether, the vehicle's depth (top left), and
 //     the labelled colour scale (bottom right), both sized from the frame with MuJoCo's font
 //     metrics;
@@ -163,6 +165,7 @@ class Renderer {
   void Decorate(const mjModel* m, const mjData* d, double distance, bool overlays);
   void DrawHud(const mjModel* m, const mjData* d);
   void DrawWater(const Rect& r);
+  void Fog(double distance);
   void Text(int x, int y, const std::string& text, float gray);
   void ComputeLayout(const mjModel* m);
   double VehiclePixels(const mjModel* m, const mjData* d, const CameraPose& p) const;
@@ -179,6 +182,8 @@ class Renderer {
   int vehicle_ = -1;                 // body whose depth the HUD shows
   double follow_distance_ = 10;      // [m] of the track camera (and follow/top when fixed)
   int track_body_ = -1;              // body the track camera looks at, or -1
+  bool wet_ = false;                 // water declared: fog
+  bool has_surface_ = false;         // a tether end starts at the surface: draw it at z = 0
   bool top_ = false;                 // "top" camera
   double follow_azimuth_ = 90;       // [deg]
   int seabed_geom_ = -1;             // a model plane at the seabed height, or -1

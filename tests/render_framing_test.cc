@@ -332,3 +332,51 @@ TEST_F(FramingCli, PlotRefusesOptionsItWouldIgnore) {
 
 }  // namespace
 }  // namespace mjtether::render
+
+namespace mjtether::render {
+namespace {
+
+// The vehicles' drawn geometry changes neither their inertia nor their contacts: the compiled
+// mass, inertia and centre of mass are those of the <inertial> each model declares (Wu 2018 for
+// the BlueROV2 Heavy; the work-class ROV's box of 4000 kg), and none of the vehicle's geoms
+// collides (as the single declared box did not: contype = conaffinity = 0).
+struct Declared {
+  const char* file;
+  double mass;        // [kg]
+  double inertia[3];  // [kg m^2] principal
+};
+
+TEST(VehicleLooks, MassInertiaAndContactsStayAsDeclared) {
+  const Declared models[] = {{"bluerov2_heavy.xml", 11.5, {0.16, 0.16, 0.16}},
+                             {"manoeuvre_surge_snap.xml", 11.5, {0.16, 0.16, 0.16}},
+                             {"manoeuvre_turn_wrap.xml", 11.5, {0.16, 0.16, 0.16}},
+                             {"manoeuvre_dive_return.xml", 11.5, {0.16, 0.16, 0.16}},
+                             {"manoeuvre_station_keeping.xml", 11.5, {0.16, 0.16, 0.16}},
+                             {"workclass_rov_tms.xml", 4000, {2667, 4333, 4333}}};
+  for (const Declared& x : models) {
+    std::string error;
+    std::unique_ptr<mjModel, ModelDeleter> model(
+        LoadModel(std::string(MJTETHER_MODELS_DIR) + "/" + x.file, &error));
+    ASSERT_NE(model, nullptr) << error;
+    const mjModel* m = model.get();
+    const int b = mj_name2id(m, mjOBJ_BODY, "rov");
+    ASSERT_GE(b, 0) << x.file;
+    // Exact: MuJoCo copies a declared <inertial> (a diagonal one needs no rotation).
+    EXPECT_EQ(m->body_mass[b], x.mass) << x.file;
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_EQ(m->body_inertia[3 * b + i], x.inertia[i]) << x.file;
+      EXPECT_EQ(m->body_ipos[3 * b + i], 0) << x.file;
+    }
+    int drawn = 0;
+    for (int g = 0; g < m->ngeom; ++g) {
+      if (m->geom_bodyid[g] != b) continue;
+      EXPECT_EQ(m->geom_contype[g], 0) << x.file << " geom " << g;
+      EXPECT_EQ(m->geom_conaffinity[g], 0) << x.file << " geom " << g;
+      drawn += m->geom_group[g] <= 2;
+    }
+    EXPECT_GE(drawn, 10) << x.file << ": frame, buoyancy, thrusters";
+  }
+}
+
+}  // namespace
+}  // namespace mjtether::render
