@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -86,6 +87,8 @@ struct Scene {
   const char* file;
   double duration;  // [s] of the manoeuvre
 };
+
+void PrintTo(const Scene& s, std::ostream* os) { *os << s.file; }
 
 class ShippedScene : public ::testing::TestWithParam<std::tuple<Scene, const char*>> {};
 
