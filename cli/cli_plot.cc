@@ -38,7 +38,28 @@ struct PlotOptions {
   std::string body;
   std::string size = "1000x700";
   std::string x, y, by;  // a column against another (cli_plot_columns.h)
+  // The options given on the command line (each mode refuses the ones it would ignore).
+  std::vector<CLI::Option*> given;
+  bool Given(const std::string& name) const {
+    for (const CLI::Option* o : given) {
+      if (o->get_name() == name) return o->count() > 0;
+    }
+    return false;
+  }
 };
+
+// Exit 2 naming the first of `names` given on the command line, which the mode `why` ignores.
+bool RefuseIgnored(const PlotOptions& opt, std::initializer_list<const char*> names,
+                   const std::string& why) {
+  for (const char* name : names) {
+    if (opt.Given(name)) {
+      std::cerr << "mjtether: plot " << opt.input << ": " << name << " is not used " << why
+                << "; remove it\n";
+      return true;
+    }
+  }
+  return false;
+}
 
 // The series to plot: time [s], tension at ends A and B [N], vehicle height z [m].
 struct Series {
@@ -210,6 +231,10 @@ int Plot(const PlotOptions& opt) {
     return 2;
   }
   if (!opt.x.empty() || !opt.y.empty()) {
+    if (RefuseIgnored(opt, {"--duration", "--every", "--tether", "--body"},
+                      "when plotting a column against another (--x, --y)")) {
+      return mjtether::cli::kExitBadInput;
+    }
     return mjtether::cli::PlotColumns({opt.input, opt.x, opt.y, opt.by, opt.out, W, H});
   }
   using namespace mjtether::cli;
@@ -220,6 +245,10 @@ int Plot(const PlotOptions& opt) {
   ModelPtr model;
   int run_status = 0;
   if (EndsWith(opt.input, ".csv")) {
+    if (RefuseIgnored(opt, {"--duration", "--every"},
+                      "when the input is a run log (.csv): the log fixes the times")) {
+      return kExitBadInput;
+    }
     guard.AddInput(opt.input, "the input");
     std::string error;
     if (!ReadLog(opt, &s, &error)) {
@@ -258,7 +287,7 @@ int Plot(const PlotOptions& opt) {
     << "set output " << Quote(out.path()) << "\n"
     << "set multiplot layout " << (s.vehicle.empty() ? 1 : 2) << ",1 title " << Quote(s.title)
     << " noenhanced\n"
-    << "set grid\nset key top right noenhanced\nset lmargin 12\n"
+    << "set grid\nset key outside below center horizontal noenhanced\nset lmargin 12\n"
     << "set ylabel 'tension [N]'\n"
     << (s.vehicle.empty() ? "set xlabel 'time [s]'\n" : "")
     << "plot $data using 1:2 with lines lw 2 lc rgb '#1f77b4' title " << Quote(s.label_a)
@@ -300,12 +329,13 @@ std::function<int()> SetupPlot(CLI::App* sub) {
       ->required()
       ->check(CLI::ExistingFile);
   sub->add_option("--out", opt->out, "PNG file to write")->required();
-  sub->add_option("--duration", opt->duration, "simulated time when INPUT is a model [s]")
-      ->check(mjtether::cli::Number(0, 1e7, false, "s"));
-  sub->add_option("--every", opt->every, "sampling interval when INPUT is a model [s]")
-      ->check(mjtether::cli::Number(0, 1e7, true, "s"));
-  sub->add_option("--tether", opt->tether, "tether to plot (default: the first)");
-  sub->add_option("--body", opt->body, "body whose depth is plotted (default: the vehicle)");
+  opt->given = {
+      sub->add_option("--duration", opt->duration, "simulated time when INPUT is a model [s]")
+          ->check(mjtether::cli::Number(0, 1e7, false, "s")),
+      sub->add_option("--every", opt->every, "sampling interval when INPUT is a model [s]")
+          ->check(mjtether::cli::Number(0, 1e7, true, "s")),
+      sub->add_option("--tether", opt->tether, "tether to plot (default: the first)"),
+      sub->add_option("--body", opt->body, "body whose depth is plotted (default: the vehicle)")};
   sub->add_option("--size", opt->size, "WIDTHxHEIGHT in pixels (default 1000x700)");
   sub->add_option("--x", opt->x, "CSV table: column for the x axis (NAME or NAME[i])");
   sub->add_option("--y", opt->y, "CSV table: column for the y axis");

@@ -2,12 +2,13 @@
 // off-screen (plugin/render.h).
 //
 //   mjtether render MODEL.xml --duration S --video out.mp4 [--fps 30] [--size 1280x720]
-//       [--camera follow|track:BODY|NAME] [--png-every S DIR] [--samples N]
-//       [--tension-max N] [--distance M] [--speedup X] [--vehicle BODY] [--no-hud]
+//       [--camera follow|top|track:BODY|NAME] [--png-every S DIR] [--samples N]
+//       [--tension-max N|auto] [--distance M|auto] [--speedup X] [--vehicle BODY] [--no-hud]
 //
 // Frame k shows the state at step round(k / (fps h)), h the model's timestep: frames are
 // scheduled by index, so they never drift from t = k/fps by more than h/2 however long the
-// video. The video has floor(duration * fps) frames and lasts duration / speedup seconds.
+// video. The video has floor(duration * fps) + 1 frames, t = 0 to the last instant of the grid
+// k/fps <= duration (so the end of the run is rendered when it falls on the grid).
 #include <unistd.h>
 
 #include <algorithm>
@@ -48,6 +49,16 @@ struct RenderCliOptions {
   std::string vehicle;
   bool no_hud = false;
 };
+
+// "auto" for --tension-max and --distance: stored as 0, the value that means automatic.
+CLI::Validator Auto() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        if (text == "auto") text = "0";
+        return "";
+      },
+      "auto", "");
+}
 
 bool ParseSize(const std::string& s, int* w, int* h) {
   char x = 0, extra = 0;
@@ -159,8 +170,8 @@ int Render(const RenderCliOptions& opt) {
 
   const double h = m->opt.timestep;
   const double frame_dt = 1.0 / opt.fps;
-  const long long nframes =
-      std::max(1LL, static_cast<long long>(std::floor(opt.duration * opt.fps + 1e-9)));
+  // Frames k = 0 .. floor(duration fps): the last instant is rendered when it is on the grid.
+  const long long nframes = static_cast<long long>(std::floor(opt.duration * opt.fps + 1e-9)) + 1;
 
   // Colour scale: given, or the largest tension of the run rounded up (a pre-pass without
   // rendering costs a small fraction of the rendering).
@@ -315,20 +326,24 @@ std::function<int()> SetupRender(CLI::App* sub) {
       ->check(mjtether::cli::Number(0.01, 1000, false, "frames/s"));
   sub->add_option("--size", opt->size, "WIDTHxHEIGHT in pixels, even numbers (default 1280x720)");
   sub->add_option("--camera", opt->camera,
-                  "follow (default), track:BODY, or the name of a <camera> in the model");
+                  "follow (default: keeps the tethers and vehicles in view, zooming smoothly), "
+                  "top (the same from above), track:BODY, or the name of a <camera> in the model");
   sub->add_option("--png-every", opt->png_every, "S DIR: a PNG still every S seconds into DIR")
       ->expected(2);
   sub->add_option("--samples", opt->samples,
                   "multisampling samples, 0 to 16 (default 4; 0 is about twice as fast)")
       ->check(CLI::Range(0, 16));
   sub->add_option("--tension-max", opt->tension_max,
-                  "top of the tension colour scale [N]; default: the run's largest tension "
-                  "rounded up to 1, 2, 3, 4, 5, 6 or 8 x 10^k")
-      ->check(mjtether::cli::Number(0, 1e12, false, "N"));
+                  "top of the tension colour scale [N], or auto (default; 0 is a synonym): the "
+                  "run's largest tension rounded up to 1, 2, 3, 4, 5, 6 or 8 x 10^k")
+      ->check(mjtether::cli::Number(0, 1e12, false, "N"))
+      ->transform(Auto());
   sub->add_option("--distance", opt->distance,
-                  "camera distance for follow and track:BODY [m] (default: 1.25 x the longest "
-                  "tether for follow, 15 x the body's radius for track)")
-      ->check(mjtether::cli::Number(0, 1e6, false, "m"));
+                  "camera distance for follow, top and track:BODY [m], fixed; or auto (default; "
+                  "0 is a synonym): follow and top zoom to keep the tethers and vehicles in view, "
+                  "track uses 15 x the body's radius, at least 1 m")
+      ->check(mjtether::cli::Number(0, 1e6, false, "m"))
+      ->transform(Auto());
   sub->add_option("--speedup", opt->speedup,
                   "the video plays this many times faster than real time (its frame rate is "
                   "fps x speedup; default 1)")

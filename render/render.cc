@@ -108,6 +108,8 @@ constexpr float kRamp[5][3] = {{0.15f, 0.30f, 1.00f},
 constexpr float kSlack[3] = {0.62f, 0.62f, 0.62f};
 constexpr float kSand[4] = {0.55f, 0.50f, 0.40f, 1.0f};
 constexpr float kArrow[4] = {0.95f, 0.95f, 1.00f, 1.0f};
+constexpr float kSurface[4] = {0.55f, 0.75f, 0.90f, 0.35f};  // translucent water surface
+constexpr float kFog[4] = {0.06f, 0.18f, 0.30f, 1.0f};       // water colour far from the eye
 
 // Background: water, darker with depth (top to bottom of the image).
 constexpr float kWaterTop[3] = {0.16f, 0.36f, 0.52f};
@@ -147,7 +149,158 @@ double BodySize(const mjModel* m, int b) {
   return r;
 }
 
+// Half extents [m] of the box that holds geom g in its own frame.
+void GeomHalfExtents(const mjModel* m, int g, double e[3]) {
+  const double* s = m->geom_size + 3 * g;
+  switch (m->geom_type[g]) {
+    case mjGEOM_BOX:
+    case mjGEOM_ELLIPSOID:
+      e[0] = s[0], e[1] = s[1], e[2] = s[2];
+      return;
+    case mjGEOM_SPHERE:
+      e[0] = e[1] = e[2] = s[0];
+      return;
+    case mjGEOM_CAPSULE:
+      e[0] = e[1] = s[0], e[2] = s[0] + s[1];
+      return;
+    case mjGEOM_CYLINDER:
+      e[0] = e[1] = s[0], e[2] = s[1];
+      return;
+    default:
+      e[0] = e[1] = e[2] = m->geom_rbound[g];
+  }
+}
+
+// The frame of a free camera: eye [m], forward, up and right unit vectors, as MuJoCo's
+// mjv_updateCamera sets them from azimuth a and elevation e: forward (cos e cos a, cos e sin a,
+// sin e), up (-sin e cos a, -sin e sin a, cos e), eye = lookat - distance forward.
+struct Frame {
+  Vec3 eye, f, u, r;
+};
+Frame MakeFrame(const CameraPose& p) {
+  const double a = p.azimuth * kPi / 180, e = p.elevation * kPi / 180;
+  Frame fr;
+  fr.f = Vec3(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
+  fr.u = Vec3(-std::sin(e) * std::cos(a), -std::sin(e) * std::sin(a), std::cos(e));
+  fr.r = fr.f.cross(fr.u);
+  fr.eye = Vec3(p.lookat[0], p.lookat[1], p.lookat[2]) - p.distance * fr.f;
+  return fr;
+}
+
+// The camera position (in the frame's r, u, f coordinates a, b, c) closest to the points along
+// f that projects every point into the normalised window [X0, X1] x [Y0, Y1] (image-plane
+// coordinates at unit depth). Each bound is linear in the eye E: (p - E).(r - X1 f) <= 0, etc.;
+// so E.n >= max_i p_i.n for four normals n, and the sum of opposite pairs bounds c. Returns c,
+// with a and b centred in their feasible intervals.
+double FitWindow(const std::vector<Vec3>& p, const Frame& fr, double X0, double X1, double Y0,
+                 double Y1, double* a, double* b) {
+  double M1 = -mjMAXVAL, M2 = -mjMAXVAL, M3 = -mjMAXVAL, M4 = -mjMAXVAL;
+  for (const Vec3& x : p) {
+    const double pr = x.dot(fr.r), pu = x.dot(fr.u), pf = x.dot(fr.f);
+    M1 = std::max(M1, pr - X1 * pf);
+    M2 = std::max(M2, -pr + X0 * pf);
+    M3 = std::max(M3, pu - Y1 * pf);
+    M4 = std::max(M4, -pu + Y0 * pf);
+  }
+  const double c = std::min(-(M1 + M2) / (X1 - X0), -(M3 + M4) / (Y1 - Y0));
+  *a = 0.5 * ((M1 + X1 * c) + (X0 * c - M2));
+  *b = 0.5 * ((M3 + Y1 * c) + (Y0 * c - M4));
+  return c;
+}
+
+// How far [m] the eye must move back along f so that every point projects into the window
+// [X0, X1] x [Y0, Y1] (X0, Y0 < 0 < X1, Y1): 0 if they all do.
+double BackOff(const std::vector<Vec3>& p, const Frame& fr, double X0, double X1, double Y0,
+               double Y1) {
+  double back = 0;
+  for (const Vec3& x : p) {
+    const Vec3 q = x - fr.eye;
+    const double qr = q.dot(fr.r), qu = q.dot(fr.u), qf = q.dot(fr.f);
+    // Moving back by s adds s to the depth qf: qr <= X1 (qf + s) etc.
+    back = std::max({back, qr / X1 - qf, qr / X0 - qf, qu / Y1 - qf, qu / Y0 - qf});
+  }
+  return back;
+}
+
+// How far [m] the eye must move back along f (which draws every projection toward the frame's
+// centre) so that no point projects into one of the blocks (grown by 2 px) that does not hold
+// the centre: for a point inside, the fraction lambda of the way to the centre where its ray
+// leaves the block gives the needed scale k = 1 - lambda of its offset, qf / (qf + s) = k
+// (s capped, see below).
+double BackOffBlocks(const std::vector<Vec3>& p, const Frame& fr, const std::vector<Rect>& blocks,
+                     int W, int H, double t) {
+  const double cx = 0.5 * W, cy = 0.5 * H;
+  double back = 0;  // the largest need of a point
+  for (const Rect& b : blocks) {
+    if (b.empty()) continue;
+    const double x0 = b.x - 2, x1 = b.x + b.w + 2, y0 = b.y - 2, y1 = b.y + b.h + 2;
+    if (cx >= x0 && cx <= x1 && cy >= y0 && cy <= y1) continue;
+    for (const Vec3& x : p) {
+      const Vec3 q = x - fr.eye;
+      const double qf = q.dot(fr.f);
+      if (qf <= 0) continue;
+      const double px = cx + q.dot(fr.r) / (qf * t) * 0.5 * H;
+      const double py = cy + q.dot(fr.u) / (qf * t) * 0.5 * H;
+      if (!(px > x0 && px < x1 && py > y0 && py < y1)) continue;
+      double lambda = 1;
+      if (cx > px && x1 < cx) lambda = std::min(lambda, (x1 - px) / (cx - px));
+      if (cx < px && x0 > cx) lambda = std::min(lambda, (x0 - px) / (cx - px));
+      if (cy > py && y1 < cy) lambda = std::min(lambda, (y1 - py) / (cy - py));
+      if (cy < py && y0 > cy) lambda = std::min(lambda, (y0 - py) / (cy - py));
+      // qf (1 / (1 - lambda) - 1), at most a quarter of the depth: a block reaching near the
+      // centre would otherwise ask for a large jump.
+      back = std::max(back, qf * std::min(lambda / (1 - lambda), 0.25));
+    }
+  }
+  return back;
+}
+
+bool Overlap(const Rect& a, const Rect& b) {
+  return !a.empty() && !b.empty() && a.x < b.x + b.w && b.x < a.x + a.w && a.y < b.y + b.h &&
+         b.y < a.y + a.h;
+}
+
+// Critically damped filter toward goal g over dt [s] with rate omega [1/s], exact for a
+// constant goal: x(t) = g + (x0 - g + (v0 + omega (x0 - g)) t) exp(-omega t).
+void Damp(double* x, double* v, double g, double omega, double dt) {
+  const double delta = *x - g, e = std::exp(-omega * dt), k = (*v + omega * delta) * dt;
+  *x = g + (delta + k) * e;
+  *v = (*v - omega * k) * e;
+}
+
+// The points the follow and top cameras keep in view: every tether node, and the corners of the
+// cube around each free body's geoms.
+std::vector<Vec3> ScenePoints(const mjModel* m, const mjData* d, const std::vector<int>& bodies,
+                              const std::vector<double>& radius) {
+  std::vector<Vec3> pts;
+  for (int k = 0; k < TetherCount(m); ++k) {
+    const double* x = NodePositions(m, d, k);
+    if (!x) continue;
+    for (int i = 0; i < GetTether(m, k)->nodes(); ++i) pts.emplace_back(x + 3 * i);
+  }
+  for (int b : bodies) {
+    const Vec3 c(d->xpos + 3 * b);
+    for (int corner = 0; corner < 8; ++corner) {
+      const Vec3 s(corner & 1 ? 1 : -1, corner & 2 ? 1 : -1, corner & 4 ? 1 : -1);
+      pts.push_back(c + radius[b] * s);
+    }
+  }
+  return pts;
+}
+
+constexpr double kFollowElevation = -20;  // [deg] follow camera: looks 20 degrees down
+constexpr double kPipFill = 0.85;  // the close-up's vehicle (its sphere) spans 85 % of its height
+
 }  // namespace
+
+std::array<double, 2> ProjectPose(const CameraPose& p, double fovy, int width, int height,
+                                  const double x[3]) {
+  const Frame fr = MakeFrame(p);
+  const Vec3 q = Vec3(x[0], x[1], x[2]) - fr.eye;
+  const double t = std::tan(0.5 * fovy * kPi / 180), z = q.dot(fr.f);
+  return {0.5 * width + q.dot(fr.r) / (z * t) * 0.5 * height,
+          0.5 * height + q.dot(fr.u) / (z * t) * 0.5 * height};
+}
 
 double NiceCeil(double x) {
   if (!(x > 0) || !std::isfinite(x)) return 1;
@@ -238,7 +391,14 @@ std::unique_ptr<Renderer> Renderer::Create(mjModel* m, const RenderOptions& opti
     r->vehicle_ = Vehicle(m);
   }
 
-  // Follow distance: the longest tether should fit in the view; side-on to the current.
+  // Bodies framed with the tethers: those with a free joint.
+  r->body_radius_.resize(m->nbody);
+  for (int b = 0; b < m->nbody; ++b) r->body_radius_[b] = BodySize(m, b);
+  for (int j = 0; j < m->njnt; ++j) {
+    if (m->jnt_type[j] == mjJNT_FREE) r->free_bodies_.push_back(m->jnt_bodyid[j]);
+  }
+
+  // Fixed follow distance (--distance, and the fallback): the longest tether in view.
   double L = 0;
   for (int k = 0; k < TetherCount(m); ++k) L = std::max(L, GetTether(m, k)->params().length);
   r->follow_distance_ = o.distance > 0 ? o.distance
@@ -264,11 +424,13 @@ std::unique_ptr<Renderer> Renderer::Create(mjModel* m, const RenderOptions& opti
     r->track_body_ = b;
     if (o.distance <= 0) r->follow_distance_ = std::max(1.0, 15 * BodySize(m, b));
     if (o.vehicle.empty()) r->vehicle_ = b;
+  } else if (c == "top") {
+    r->top_ = true;
   } else if (c != "follow") {
     const int id = mj_name2id(m, mjOBJ_CAMERA, c.c_str());
     if (id < 0) {
-      *error =
-          "--camera " + c + ": not 'follow', 'track:BODY' or the name of a <camera> in the model";
+      *error = "--camera " + c +
+               ": not 'follow', 'top', 'track:BODY' or the name of a <camera> in the model";
       return nullptr;
     }
     r->cam_.type = mjCAMERA_FIXED;
@@ -276,7 +438,20 @@ std::unique_ptr<Renderer> Renderer::Create(mjModel* m, const RenderOptions& opti
   }
   r->cam_.distance = r->follow_distance_;
   r->cam_.azimuth = r->follow_azimuth_;
-  r->cam_.elevation = -12;
+  r->cam_.elevation = r->top_ ? -90 : kFollowElevation;
+
+  // Water: fog; a surface when a tether end starts within 1 m of z = 0.
+  if (TetherCount(m) > 0 && GetTether(m, 0)->env().wet) {
+    r->wet_ = true;
+    mjData* d0 = mj_makeData(m);
+    mj_forward(m, d0);
+    for (int k = 0; k < TetherCount(m); ++k) {
+      const double* x = NodePositions(m, d0, k);
+      const int n = GetTether(m, k)->nodes();
+      if (x && (std::abs(x[2]) < 1 || std::abs(x[3 * (n - 1) + 2]) < 1)) r->has_surface_ = true;
+    }
+    mj_deleteData(d0);
+  }
 
   // A model plane at the seabed height stands for the seabed; otherwise one is drawn.
   if (TetherCount(m) > 0 && GetTether(m, 0)->env().water.has_seabed) {
@@ -310,21 +485,36 @@ std::unique_ptr<Renderer> Renderer::Create(mjModel* m, const RenderOptions& opti
   m->vis.global.offwidth = o.width;
   m->vis.global.offheight = o.height;
   m->vis.quality.offsamples = o.samples;
+  // The far clipping plane (a multiple of the model's extent, which ignores the tethers) beyond
+  // the farthest the follow camera goes: a few tether lengths.
+  if (m->stat.extent > 0) {
+    m->vis.map.zfar = std::max<float>(m->vis.map.zfar, (10 * L + 100) / m->stat.extent);
+  }
 
   int tether_geoms = 0;
   for (int k = 0; k < TetherCount(m); ++k) tether_geoms += GetTether(m, k)->segments();
   mjv_makeScene(m, &r->scn_, 2000 + m->ngeom + tether_geoms);
   r->scene_made_ = true;
-  const int fontscale = o.height <= 500   ? mjFONTSCALE_100
-                        : o.height <= 900 ? mjFONTSCALE_150
-                                          : mjFONTSCALE_200;
   // Light the scene from the camera enough that a deep seabed is not black.
   m->vis.headlight.ambient[0] = m->vis.headlight.ambient[1] = m->vis.headlight.ambient[2] =
       std::max(m->vis.headlight.ambient[0], 0.25f);
   m->vis.headlight.diffuse[0] = m->vis.headlight.diffuse[1] = m->vis.headlight.diffuse[2] =
       std::max(m->vis.headlight.diffuse[0], 0.6f);
-  mjr_makeContext(m, &r->con_, fontscale);
-  r->context_made_ = true;
+  // Font: 150 % at 720 rows, in proportion to the height (MuJoCo has 50 % steps), smaller
+  // while the HUD or the colour scale would take too much of the frame.
+  int fontscale = std::clamp(50 * static_cast<int>(std::lround(3.0 * o.height / 720)), 50, 300);
+  for (;; fontscale -= 50) {
+    mjr_makeContext(m, &r->con_, fontscale);
+    r->context_made_ = true;
+    r->ComputeLayout(m);
+    const Layout& l = r->layout_;
+    const bool fits = l.hud.w <= 0.45 * o.width && l.hud.h <= 0.4 * o.height &&
+                      l.scale.w <= 0.7 * o.width && l.scale.h <= 0.25 * o.height;
+    if (fits || fontscale <= 50) break;
+    mjr_freeContext(&r->con_);
+    mjr_defaultContext(&r->con_);
+    r->context_made_ = false;
+  }
   mjr_setBuffer(mjFB_OFFSCREEN, &r->con_);
   if (r->con_.currentBuffer != mjFB_OFFSCREEN) {
     *error = "MuJoCo: the off-screen framebuffer is not available";
@@ -349,54 +539,271 @@ Renderer::~Renderer() {
   if (osmesa_) gl_->DestroyContext(static_cast<OSMesaContext>(osmesa_));
 }
 
-// The follow camera looks at the centre of the box that bounds the tethers' nodes and the
-// vehicle: it moves with the vehicle and keeps the whole tether in view. The track camera looks
-// at its body's origin. Both are set from the state alone, so a frame does not depend on the
-// frames before it (MuJoCo's own tracking camera filters its motion from frame to frame).
-void Renderer::PlaceCamera(const mjModel* m, const mjData* d) {
-  if (cam_.type != mjCAMERA_FREE) return;
-  if (track_body_ >= 0) {
-    for (int i = 0; i < 3; ++i) cam_.lookat[i] = d->xpos[3 * track_body_ + i];
-    return;
-  }
-  Vec3 lo = Vec3::Constant(mjMAXVAL), hi = Vec3::Constant(-mjMAXVAL);
-  auto add = [&](const double* p) {
-    lo = lo.cwiseMin(Vec3(p));
-    hi = hi.cwiseMax(Vec3(p));
-  };
-  for (int k = 0; k < TetherCount(m); ++k) {
-    const double* x = NodePositions(m, d, k);
-    if (!x) continue;
-    for (int i = 0; i < GetTether(m, k)->nodes(); ++i) add(x + 3 * i);
-  }
-  if (vehicle_ >= 0) add(d->xpos + 3 * vehicle_);
-  const Vec3 lookat = lo.x() <= hi.x() ? Vec3(0.5 * (lo + hi)) : Vec3(m->stat.center);
-  for (int i = 0; i < 3; ++i) cam_.lookat[i] = lookat[i];
+int Renderer::TextWidth(const std::string& text) const {
+  int w = 0;
+  for (unsigned char c : text) w += c < 127 ? con_.charWidth[c] : 0;
+  return w;
 }
 
-// Tethers, seabed and the current arrow, added to the scene as decor geoms.
-void Renderer::Decorate(const mjModel* m, const mjData* d) {
+Layout Renderer::layout() const {
+  Layout l = layout_;
+  if (!pip_shown_) l.pip = Rect();
+  return l;
+}
+
+// The HUD's lines (title, and the widest value it can show), one per quantity.
+// Compact (narrow frames): shorter titles.
+static std::vector<std::string> HudTitles(const mjModel* m, int vehicle, bool compact) {
+  std::vector<std::string> t = {"time"};
+  const int n = TetherCount(m);
+  for (int k = 0; k < n; ++k) {
+    const std::string prefix = n > 1 ? TetherName(m, k) + ": " : "";
+    for (int end = 0; end < 2; ++end) {
+      t.push_back(prefix + (compact ? "T " : "T at ") + BodyName(m, EndBody(m, k, end)));
+    }
+  }
+  if (vehicle >= 0) {
+    t.push_back(compact ? "depth" : "depth of " + BodyName(m, vehicle));
+    if (n > 0 && GetTether(m, 0)->env().water.has_seabed) t.push_back("altitude");
+  }
+  if (n > 0 && GetTether(m, 0)->env().water.current.norm() > 0) t.push_back("current");
+  return t;
+}
+
+// Rectangles of the overlays, from the font's metrics and the frame size.
+void Renderer::ComputeLayout(const mjModel* m) {
+  const int W = opt_.width, H = opt_.height, ch = con_.charHeight;
+  const int pad = std::max(2, ch / 4);
+  Layout l;
+  if (opt_.hud) {
+    int tw = 0;
+    const std::vector<std::string> titles = HudTitles(m, vehicle_, W < 480);
+    for (const std::string& t : titles) tw = std::max(tw, TextWidth(t));
+    const int vw = std::max(TextWidth("-0000.0 N"), TextWidth("000.00 m/s"));
+    l.hud = {0, 0, pad + tw + ch / 2 + vw + pad, static_cast<int>(titles.size()) * ch + 2 * pad};
+    l.hud.y = H - l.hud.h;
+    if (TetherCount(m) > 0) {
+      // Colour scale, from the bottom: tick labels, bar, title; the slack swatch on the left.
+      int tick = 0;
+      const double tmax = opt_.tension_max > 0 ? opt_.tension_max : 1;
+      char buf[64];
+      for (int i = 0; i <= 4; ++i) {
+        std::snprintf(buf, sizeof(buf), "%g", tmax * i / 4);
+        tick = std::max(tick, TextWidth(buf));
+      }
+      const int title = TextWidth("segment tension [N]");
+      const int bar_w = std::max({W / 4, title, 4 * (tick + ch / 2)});
+      const int bar_h = std::max(4, ch / 2);
+      const int slack = std::max(TextWidth("slack"), ch);
+      const int right = W - pad - tick / 2;  // bar's right end: the last tick label fits
+      const int left = right - bar_w;
+      l.scale.x = left - ch / 2 - slack - pad;
+      l.scale.w = W - l.scale.x;
+      l.scale.h = pad + ch + pad / 2 + bar_h + pad / 2 + ch + pad;
+      l.label = {left + (bar_w - title) / 2, l.scale.h - pad - ch, title, ch};
+    }
+  }
+  if (TetherCount(m) > 0 && GetTether(m, 0)->env().water.current.norm() > 0) {
+    const int w = std::max(W / 7, 4 * ch), h = std::max(H / 7, 3 * ch);
+    l.arrow = {W - w, H - h, w, h};
+  }
+  if (vehicle_ >= 0 && opt_.pip_min_px > 0) {
+    int h = std::max(H * 3 / 10, 96), w = h * 4 / 3;
+    if (w > 2 * W / 5) w = 2 * W / 5, h = w * 3 / 4;
+    l.pip = {pad, pad, w, h};
+  }
+  layout_ = l;
+}
+
+// Projected size [pixel] of body b's drawn geoms through pose p: the larger side of the box
+// bounding the projections of their boxes' corners.
+double Renderer::VehiclePixels(const mjModel* m, const mjData* d, const CameraPose& p) const {
+  double lo[2] = {mjMAXVAL, mjMAXVAL}, hi[2] = {-mjMAXVAL, -mjMAXVAL};
+  for (int g = 0; g < m->ngeom; ++g) {
+    if (m->geom_bodyid[g] != vehicle_) continue;
+    const int group = std::clamp(m->geom_group[g], 0, mjNGROUP - 1);
+    if (!vopt_.geomgroup[group] || m->geom_rgba[4 * g + 3] == 0) continue;
+    double e[3];
+    GeomHalfExtents(m, g, e);
+    for (int corner = 0; corner < 8; ++corner) {
+      double local[3], world[3];
+      for (int i = 0; i < 3; ++i) local[i] = (corner >> i & 1 ? 1 : -1) * e[i];
+      mju_rotVecMat(world, local, d->geom_xmat + 9 * g);
+      mju_addTo3(world, d->geom_xpos + 3 * g);
+      const std::array<double, 2> px =
+          ProjectPose(p, m->vis.global.fovy, opt_.width, opt_.height, world);
+      for (int i = 0; i < 2; ++i) lo[i] = std::min(lo[i], px[i]), hi[i] = std::max(hi[i], px[i]);
+    }
+  }
+  return lo[0] <= hi[0] ? std::max(hi[0] - lo[0], hi[1] - lo[1]) : 0;
+}
+
+CameraPose Renderer::PipPose(const mjModel* m, const mjData* d, const CameraPose& main) const {
+  CameraPose p = main;
+  const double t = std::tan(0.5 * m->vis.global.fovy * kPi / 180);
+  const double radius = std::max(body_radius_[vehicle_], 1e-3);
+  for (int i = 0; i < 3; ++i) p.lookat[i] = d->xpos[3 * vehicle_ + i];
+  p.distance = radius / (kPipFill * t);
+  p.pip = false;
+  return p;
+}
+
+// The framing the follow and top cameras move toward: the closest camera, in their direction,
+// that projects every tether node and every free body (the cube around its geoms) into the
+// largest free part of the frame (outside the overlays' rectangles, with a margin).
+CameraPose Renderer::Target(const mjModel* m, const mjData* d, bool pip) const {
+  CameraPose p;
+  p.azimuth = follow_azimuth_;
+  p.elevation = top_ ? -90 : kFollowElevation;
+  p.distance = follow_distance_;
+  std::vector<Vec3> pts = ScenePoints(m, d, free_bodies_, body_radius_);
+  double Dmin = 1;  // [m] closest the camera gets to the middle of the scene
+  for (int b : free_bodies_) Dmin = std::max(Dmin, 4 * body_radius_[b]);
+  if (pts.empty()) pts.emplace_back(m->stat.center[0], m->stat.center[1], m->stat.center[2]);
+  Vec3 lo = pts[0], hi = pts[0];
+  for (const Vec3& x : pts) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
+  if (opt_.distance > 0) {  // fixed distance: look at the middle of the box bounding them
+    for (int i = 0; i < 3; ++i) p.lookat[i] = 0.5 * (lo[i] + hi[i]);
+    return p;
+  }
+
+  // Free rectangles: every one whose sides lie on the frame's or the overlays' edges and that
+  // covers no overlay; the one that lets the camera come closest wins.
+  const int W = opt_.width, H = opt_.height;
+  std::vector<Rect> blocks = {layout_.hud, layout_.scale, layout_.arrow};
+  if (pip) blocks.push_back(layout_.pip);
+  std::vector<int> xs = {0, W}, ys = {0, H};
+  for (const Rect& b : blocks) {
+    if (b.empty()) continue;
+    xs.insert(xs.end(), {b.x, b.x + b.w});
+    ys.insert(ys.end(), {b.y, b.y + b.h});
+  }
+  const double t = std::tan(0.5 * m->vis.global.fovy * kPi / 180);
+  const double margin = std::max(4.0, 0.03 * std::min(W, H));  // [pixel]
+  auto nx = [&](double px) { return (px - 0.5 * W) / (0.5 * H) * t; };
+  auto ny = [&](double py) { return (py - 0.5 * H) / (0.5 * H) * t; };
+  const Frame fr = MakeFrame(p);
+  double best_c = -mjMAXVAL, best_a = 0, best_b = 0;
+  for (int x0 : xs) {
+    for (int x1 : xs) {
+      if (x1 - x0 < W / 3) continue;
+      for (int y0 : ys) {
+        for (int y1 : ys) {
+          if (y1 - y0 < H / 3) continue;
+          const Rect r = {x0, y0, x1 - x0, y1 - y0};
+          bool free = true;
+          for (const Rect& b : blocks) free = free && !Overlap(r, b);
+          if (!free) continue;
+          double a, b;
+          const double c = FitWindow(pts, fr, nx(x0 + margin), nx(x1 - margin), ny(y0 + margin),
+                                     ny(y1 - margin), &a, &b);
+          if (c > best_c) best_c = c, best_a = a, best_b = b;
+        }
+      }
+    }
+  }
+  if (best_c == -mjMAXVAL) {  // no free rectangle that large: the whole frame
+    best_c = FitWindow(pts, fr, nx(margin), nx(W - margin), ny(margin), ny(H - margin), &best_a,
+                       &best_b);
+  }
+  // Distance: to the middle of the points' depths, at least Dmin.
+  double fmin = mjMAXVAL, fmax = -mjMAXVAL;
+  for (const Vec3& x : pts) fmin = std::min(fmin, x.dot(fr.f)), fmax = std::max(fmax, x.dot(fr.f));
+  const double mid = 0.5 * (fmin + fmax);
+  double c = best_c;
+  if (mid - c < Dmin) c = mid - Dmin;
+  const Vec3 eye = best_a * fr.r + best_b * fr.u + c * fr.f;
+  p.distance = mid - c;
+  const Vec3 look = eye + p.distance * fr.f;
+  for (int i = 0; i < 3; ++i) p.lookat[i] = look[i];
+  return p;
+}
+
+CameraPose Renderer::NextPose(const mjModel* m, const mjData* d) {
+  CameraPose p;
+  p.azimuth = follow_azimuth_;
+  p.elevation = top_ ? -90 : kFollowElevation;
+  p.distance = follow_distance_;
+  if (cam_.type != mjCAMERA_FREE) return p;
+  if (track_body_ >= 0) {
+    for (int i = 0; i < 3; ++i) p.lookat[i] = d->xpos[3 * track_body_ + i];
+    return p;
+  }
+  // Filter the look-at point and log(distance) toward the target (the first frame, a frame
+  // back in time and no smoothing jump to it).
+  CameraPose target = Target(m, d, pip_shown_);
+  if (!filter_started_ && vehicle_ >= 0 && opt_.pip_min_px > 0 &&
+      VehiclePixels(m, d, target) < opt_.pip_min_px) {
+    pip_shown_ = true;  // the first frame is framed with the close-up it will show
+    target = Target(m, d, true);
+  }
+  const double goal[4] = {target.lookat[0], target.lookat[1], target.lookat[2],
+                          std::log(target.distance)};
+  const double dt = d->time - filter_time_;
+  if (!filter_started_ || !(dt >= 0) || !(opt_.smoothing > 0)) {
+    for (int i = 0; i < 4; ++i) state_[i] = goal[i], rate_[i] = 0;
+    filter_started_ = true;
+  } else {
+    for (int i = 0; i < 4; ++i) Damp(&state_[i], &rate_[i], goal[i], 1 / opt_.smoothing, dt);
+  }
+  filter_time_ = d->time;
+  for (int i = 0; i < 3; ++i) p.lookat[i] = state_[i];
+  p.distance = std::exp(state_[3]);
+
+  // The filter lags: back off along the view if a node or a vehicle would leave the frame.
+  if (opt_.distance <= 0) {
+    const std::vector<Vec3> pts = ScenePoints(m, d, free_bodies_, body_radius_);
+    const double t = std::tan(0.5 * m->vis.global.fovy * kPi / 180);
+    const double X = 0.97 * t * opt_.width / opt_.height, Y = 0.97 * t;
+    double back = BackOff(pts, MakeFrame(p), -X, X, -Y, Y);
+    // Then out of the overlays (a few rounds: a point drawn toward the centre may enter another).
+    // (Not out of the close-up: it appears at once, the filter moves the scene away from it.)
+    const std::vector<Rect> blocks = {layout_.hud, layout_.scale, layout_.arrow};
+    for (int round = 0; round < 3; ++round) {
+      CameraPose q = p;
+      q.distance += back;
+      const double more = BackOffBlocks(pts, MakeFrame(q), blocks, opt_.width, opt_.height, t);
+      if (!(more > 0)) break;
+      back += more;
+    }
+    if (back > 0) {
+      p.distance += back;
+      state_[3] = std::log(p.distance);
+      rate_[3] = std::max(rate_[3], 0.0);
+    }
+  }
+
+  // Close-up: on below pip_min_px, off above 1.2 x (no flicker at the threshold).
+  if (vehicle_ >= 0 && opt_.pip_min_px > 0) {
+    const double size = VehiclePixels(m, d, p);
+    if (size < opt_.pip_min_px) pip_shown_ = true;
+    if (size > 1.2 * opt_.pip_min_px) pip_shown_ = false;
+  }
+  p.pip = pip_shown_;
+  return p;
+}
+
+// Tethers, seabed and (overlays: in the main view) the current arrow, added to the scene as
+// decor geoms; D [m] is the camera's distance (tether thickness, seabed size).
+void Renderer::Decorate(const mjModel* m, const mjData* d, double D, bool overlays) {
   std::vector<double> T;
-  const mjvGLCamera& gl = scn_.camera[0];
-  // Camera frame and a reference point in front of it at the follow distance.
+  const mjvGLCamera gl = mjv_averageCamera(&scn_.camera[0], &scn_.camera[1]);
+  // Camera frame and a reference point in front of it at distance D.
   const Vec3 eye(gl.pos[0], gl.pos[1], gl.pos[2]);
   const Vec3 fwd(gl.forward[0], gl.forward[1], gl.forward[2]);
   const Vec3 up(gl.up[0], gl.up[1], gl.up[2]);
   const Vec3 right = fwd.cross(up);
-  const double D = follow_distance_;
   const Vec3 ref = eye + D * fwd;
-  const double half_h = D * 0.5 * (gl.frustum_top - gl.frustum_bottom) / gl.frustum_near;
-  const double half_w = half_h * opt_.width / opt_.height;
-
+  const double t = 0.5 * (gl.frustum_top - gl.frustum_bottom) / gl.frustum_near;
   if (opt_.draw_tethers) {
     for (int k = 0; k < TetherCount(m); ++k) {
-      const Tether& t = *GetTether(m, k);
+      const Tether& tether = *GetTether(m, k);
       const double* x = NodePositions(m, d, k);
       if (!x) continue;
-      T.resize(t.segments());
+      T.resize(tether.segments());
       GetTensions(m, d, k, T.data());
-      const double radius = DrawnRadius(t, D);
-      for (int j = 0; j < t.segments(); ++j) {
+      const double radius = DrawnRadius(tether, D);
+      for (int j = 0; j < tether.segments(); ++j) {
         const double* a = x + 3 * j;
         const double* b = x + 3 * j + 3;
         if (mju_dist3(a, b) < 1e-9) continue;
@@ -428,91 +835,119 @@ void Renderer::Decorate(const mjModel* m, const mjData* d) {
     }
   }
 
-  // Current: an arrow in the upper right of the view, 0.5 D per m/s (at most 0.4 D).
-  const double speed = w.current.norm();
-  if (speed > 0) {
+  // Water surface: a translucent sheet at z = 0 under the reference point, when the scene has
+  // one (a tether end within 1 m of z = 0 at the start).
+  if (has_surface_) {
     if (mjvGeom* g = NextGeom(&scn_)) {
+      const mjtNum size[3] = {4 * D, 4 * D, 1e-3 * D};
+      const mjtNum pos[3] = {ref.x(), ref.y(), 0};
+      const mjtNum mat[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+      mjv_initGeom(g, mjGEOM_BOX, size, pos, mat, kSurface);
+      FinishDecor(g, &scn_);
+    }
+  }
+
+  // Current: an arrow in the top-right rectangle, 0.5 D per m/s, at most 70 % of its width.
+  const double speed = w.current.norm();
+  const Rect& box = layout_.arrow;
+  if (overlays && speed > 0 && !box.empty()) {
+    if (mjvGeom* g = NextGeom(&scn_)) {
+      const double W = opt_.width, H = opt_.height;
+      const double per_px = 2 * D * t / H;  // [m] per pixel at depth D
       const Vec3 dir = w.current / speed;
-      const double len = std::min(0.5 * D * speed, 0.4 * D);
-      const Vec3 c = ref + 0.7 * half_h * up + 0.6 * half_w * right;
+      const double len = std::min(0.5 * D * speed, 0.7 * box.w * per_px);
+      const double cx = box.x + 0.5 * box.w - 0.5 * W, cy = box.y + 0.5 * box.h - 0.5 * H;
+      const Vec3 c = ref + cx * per_px * right + cy * per_px * up;
       const Vec3 a = c - 0.5 * len * dir, b = c + 0.5 * len * dir;
       mjv_initGeom(g, mjGEOM_ARROW, nullptr, nullptr, nullptr, kArrow);
-      mjv_makeConnector(g, mjGEOM_ARROW, 0.012 * D, a.x(), a.y(), a.z(), b.x(), b.y(), b.z());
+      mjv_makeConnector(g, mjGEOM_ARROW, 0.04 * std::min(box.w, box.h) * per_px, a.x(), a.y(),
+                        a.z(), b.x(), b.y(), b.z());
       FinishDecor(g, &scn_);
     }
   }
 }
 
+// Text left-aligned at (x, y) [pixel]: mjr_label centres its text in the rectangle, which is
+// as wide as the text.
+void Renderer::Text(int x, int y, const std::string& text, float gray) {
+  mjr_label({x, y, TextWidth(text), con_.charHeight}, mjFONT_NORMAL, text.c_str(), 0, 0, 0, 0, gray,
+            gray, gray, &con_);
+}
+
 void Renderer::DrawHud(const mjModel* m, const mjData* d) {
-  const mjrRect view = {0, 0, opt_.width, opt_.height};
-  std::string titles = "time", values;
+  const int ch = con_.charHeight, pad = std::max(2, ch / 4);
   char buf[128];
+  // Top left: one line per quantity, the title left and its value right-aligned.
+  const std::vector<std::string> titles = HudTitles(m, vehicle_, opt_.width < 480);
+  std::vector<std::string> values;
   std::snprintf(buf, sizeof(buf), "%.2f s", d->time);
-  values = buf;
+  values.push_back(buf);
   for (int k = 0; k < TetherCount(m); ++k) {
     const EndReactions r = GetReactions(m, d, k);
-    const std::string name = TetherName(m, k);
-    std::snprintf(buf, sizeof(buf), "\n%.1f N\n%.1f N", r.tension_a, r.tension_b);
-    values += buf;
-    titles += "\n" + name + ": T at end A (" + BodyName(m, EndBody(m, k, 0)) + ")\n" + name +
-              ": T at end B (" + BodyName(m, EndBody(m, k, 1)) + ")";
+    for (double T : {r.tension_a, r.tension_b}) {
+      std::snprintf(buf, sizeof(buf), "%.1f N", T);
+      values.push_back(buf);
+    }
   }
   if (vehicle_ >= 0) {
-    std::snprintf(buf, sizeof(buf), "\n%.2f m", -d->xpos[3 * vehicle_ + 2]);
-    values += buf;
-    titles += "\ndepth of " + BodyName(m, vehicle_);
+    std::snprintf(buf, sizeof(buf), "%.2f m", -d->xpos[3 * vehicle_ + 2]);
+    values.push_back(buf);
     if (TetherCount(m) > 0 && GetTether(m, 0)->env().water.has_seabed) {
-      std::snprintf(buf, sizeof(buf), "\n%.2f m",
+      std::snprintf(buf, sizeof(buf), "%.2f m",
                     d->xpos[3 * vehicle_ + 2] - GetTether(m, 0)->env().water.seabed);
-      values += buf;
-      titles += "\naltitude";
+      values.push_back(buf);
     }
   }
   if (TetherCount(m) > 0 && GetTether(m, 0)->env().water.current.norm() > 0) {
-    std::snprintf(buf, sizeof(buf), "\n%.2f m/s", GetTether(m, 0)->env().water.current.norm());
-    values += buf;
-    titles += "\ncurrent (white arrow)";
+    std::snprintf(buf, sizeof(buf), "%.2f m/s", GetTether(m, 0)->env().water.current.norm());
+    values.push_back(buf);
   }
-  mjr_overlay(mjFONT_NORMAL, mjGRID_TOPLEFT, view, titles.c_str(), values.c_str(), &con_);
+  const Rect& hud = layout_.hud;
+  mjr_rectangle({hud.x, hud.y, hud.w, hud.h}, 0.0f, 0.0f, 0.0f, 0.55f);
+  for (size_t i = 0; i < titles.size() && i < values.size(); ++i) {
+    const int y = hud.y + hud.h - pad - static_cast<int>(i + 1) * ch;
+    Text(hud.x + pad, y, titles[i], 0.85f);
+    // A value wider than the room reserved (unlikely: 13 characters) is clipped at the panel.
+    Text(std::max(hud.x + hud.w - pad - TextWidth(values[i]), hud.x + pad), y, values[i], 1);
+  }
 
   if (TetherCount(m) == 0) return;
-  // Colour scale, bottom right: a ramp over [0, tension_max], ticks, and a slack swatch.
-  const int W = opt_.width, H = opt_.height;
-  const int ch = con_.charHeight;
-  const int pad = std::max(4, H / 80);
-  const int bar_w = W / 3, bar_h = std::max(6, H / 40);
-  const int slack_w = std::max(6, W / 30);
-  const int label_w = std::max(slack_w, W / 12);
-  const int left = W - pad - label_w / 2 - bar_w;
-  const int bottom = pad + ch + pad;
-  const mjrRect panel = {left - 3 * pad - label_w, pad / 2, W - (left - 3 * pad - label_w),
-                         bottom + bar_h + 2 * pad + ch};
-  mjr_rectangle(panel, 0.0f, 0.0f, 0.0f, 0.55f);
+  // Bottom right: a ramp over [0, tension_max], tick labels, its title, and a slack swatch.
+  const Rect& sc = layout_.scale;
+  const Rect& title = layout_.label;
+  mjr_rectangle({sc.x, sc.y, sc.w, sc.h}, 0.0f, 0.0f, 0.0f, 0.55f);
+  int tick = 0;
+  const double tmax = opt_.tension_max > 0 ? opt_.tension_max : 1;
+  for (int i = 0; i <= 4; ++i) {
+    std::snprintf(buf, sizeof(buf), "%g", tmax * i / 4);
+    tick = std::max(tick, TextWidth(buf));
+  }
+  const int right = opt_.width - pad - tick / 2;
+  const int bar_w = std::max({opt_.width / 4, title.w, 4 * (tick + ch / 2)});
+  const int left = right - bar_w;
+  const int bar_h = std::max(4, ch / 2);
+  const int bar_y = sc.y + pad + ch + pad / 2;
   const int nstrip = 64;
   for (int i = 0; i < nstrip; ++i) {
     float rgba[4];
     TensionColor((i + 0.5) / nstrip * opt_.tension_max, opt_.tension_max, rgba);
     const int x0 = left + i * bar_w / nstrip, x1 = left + (i + 1) * bar_w / nstrip;
-    mjr_rectangle({x0, bottom, x1 - x0, bar_h}, rgba[0], rgba[1], rgba[2], 1);
+    mjr_rectangle({x0, bar_y, x1 - x0, bar_h}, rgba[0], rgba[1], rgba[2], 1);
   }
-  auto label = [&](int cx, int y, int w, const char* text) {
-    mjr_label({cx - w / 2, y, w, ch + 2}, mjFONT_NORMAL, text, 0, 0, 0, 0, 1, 1, 1, &con_);
-  };
-  const double tmax = opt_.tension_max > 0 ? opt_.tension_max : 1;
   for (int i = 0; i <= 4; ++i) {
     std::snprintf(buf, sizeof(buf), "%g", tmax * i / 4);
-    label(left + i * bar_w / 4, pad, label_w, buf);
+    Text(left + i * bar_w / 4 - TextWidth(buf) / 2, sc.y + pad, buf, 1);
   }
-  label(left + bar_w / 2, bottom + bar_h + pad, bar_w, "segment tension [N]");
-  const int sx = left - 2 * pad - label_w / 2;
-  mjr_rectangle({sx - slack_w / 2, bottom + bar_h / 4, slack_w, bar_h / 2}, kSlack[0], kSlack[1],
-                kSlack[2], 1);
-  label(sx, pad, label_w, "slack");
+  Text(title.x, title.y, "segment tension [N]", 1);
+  const int slack = std::max(TextWidth("slack"), ch);
+  const int sx = left - ch / 2 - slack;  // left edge of the slack column
+  mjr_rectangle({sx + (slack - ch) / 2, bar_y, ch, bar_h}, kSlack[0], kSlack[1], kSlack[2], 1);
+  Text(sx + (slack - TextWidth("slack")) / 2, sc.y + pad, "slack", 1);
 }
 
-// Water behind the scene: a vertical gradient drawn at the far plane, where the depth test lets
-// it through only on pixels that nothing else covered.
-void Renderer::DrawWater() {
+// Water behind the scene in rectangle r: a vertical gradient drawn at the far plane, where the
+// depth test lets it through only on pixels that nothing else covered.
+void Renderer::DrawWater(const Rect& r) {
   gl_->PushAttrib(GL_ALL_ATTRIB_BITS);
   gl_->Disable(GL_LIGHTING);
   gl_->Disable(GL_TEXTURE_2D);
@@ -522,7 +957,7 @@ void Renderer::DrawWater() {
   gl_->Enable(GL_DEPTH_TEST);
   gl_->DepthFunc(GL_LEQUAL);
   gl_->DepthMask(GL_FALSE);
-  gl_->Viewport(0, 0, opt_.width, opt_.height);
+  gl_->Viewport(r.x, r.y, r.w, r.h);
   gl_->MatrixMode(GL_PROJECTION);
   gl_->PushMatrix();
   gl_->LoadIdentity();
@@ -545,19 +980,63 @@ void Renderer::DrawWater() {
   gl_->PopAttrib();
 }
 
+// Depth cue in water: linear fog toward the water's colour, from 0.7 D to 4 D from the eye (D
+// the camera's distance to what it looks at).
+void Renderer::Fog(double D) {
+  scn_.flags[mjRND_FOG] = wet_;
+  con_.fogStart = static_cast<float>(0.7 * D);
+  con_.fogEnd = static_cast<float>(4 * D);
+  std::copy(kFog, kFog + 4, con_.fogRGBA);
+}
+
 void Renderer::Render(const mjModel* m, mjData* d, unsigned char* rgb, float* depth) {
+  RenderAt(m, d, NextPose(m, d), rgb, depth);
+}
+
+void Renderer::RenderAt(const mjModel* m, mjData* d, const CameraPose& pose, unsigned char* rgb,
+                        float* depth) {
   gl_->MakeCurrent(static_cast<OSMesaContext>(osmesa_), osmesa_buffer_.get(), GL_UNSIGNED_BYTE,
                    opt_.width, opt_.height);
   mjr_setBuffer(mjFB_OFFSCREEN, &con_);
-  PlaceCamera(m, d);
+  const bool free_camera = cam_.type == mjCAMERA_FREE;
+  if (free_camera) {
+    for (int i = 0; i < 3; ++i) cam_.lookat[i] = pose.lookat[i];
+    cam_.distance = pose.distance;
+    cam_.azimuth = pose.azimuth;
+    cam_.elevation = pose.elevation;
+  }
+  const double D = free_camera ? pose.distance : follow_distance_;
   mjv_updateScene(m, d, &vopt_, nullptr, &cam_, mjCAT_ALL, &scn_);
-  Decorate(m, d);
-  const mjrRect view = {0, 0, opt_.width, opt_.height};
-  mjr_render(view, &scn_, &con_);
-  DrawWater();
+  Decorate(m, d, D, true);
+  Fog(D);
+  const Rect all = {0, 0, opt_.width, opt_.height};
+  mjr_render({0, 0, opt_.width, opt_.height}, &scn_, &con_);
+  DrawWater(all);
+
+  // Close-up of the vehicle, bottom left, framed by a thin light border.
+  pip_rendered_ = false;
+  if (free_camera && pose.pip && vehicle_ >= 0 && !layout_.pip.empty()) {
+    const mjvGLCamera main[2] = {scn_.camera[0], scn_.camera[1]};
+    const CameraPose pp = PipPose(m, d, pose);
+    mjvCamera cam = cam_;
+    for (int i = 0; i < 3; ++i) cam.lookat[i] = pp.lookat[i];
+    cam.distance = pp.distance;
+    mjv_updateScene(m, d, &vopt_, nullptr, &cam, mjCAT_ALL, &scn_);
+    Decorate(m, d, pp.distance, false);
+    Fog(pp.distance);
+    const Rect& r = layout_.pip;
+    const int b = std::max(1, opt_.height / 240);
+    mjr_rectangle({r.x - b, r.y - b, r.w + 2 * b, r.h + 2 * b}, 0.9f, 0.9f, 0.9f, 1);
+    mjr_render({r.x, r.y, r.w, r.h}, &scn_, &con_);
+    DrawWater(r);
+    pip_camera_[0] = mjv_averageCamera(&scn_.camera[0], &scn_.camera[1]);
+    pip_rendered_ = true;
+    scn_.camera[0] = main[0];
+    scn_.camera[1] = main[1];
+  }
   if (opt_.hud) DrawHud(m, d);
 
-  mjr_readPixels(rgb, depth, view, &con_);
+  mjr_readPixels(rgb, depth, {0, 0, opt_.width, opt_.height}, &con_);
 }
 
 }  // namespace mjtether::render

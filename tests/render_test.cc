@@ -378,23 +378,24 @@ TEST_F(RenderCli, VideoHasTheFrameCountAndSizeAsked) {
             " --png-every 0.5 " + (dir_ / "stills").string() + " 2>&1",
         &status);
   ASSERT_EQ(status, 0);
-  // 1 s at 10 fps: frames at t = 0, 0.1, ..., 0.9, played at 10 x 2 = 20 frames per second.
+  // 1 s at 10 fps: frames at t = 0, 0.1, ..., 1.0 (the last instant is on the grid), played
+  // at 10 x 2 = 20 frames per second.
   const std::string probe = Shell(
       "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
       "stream=width,height,nb_read_frames,codec_name,pix_fmt,r_frame_rate -of csv=p=0 " +
           video,
       &status);
   ASSERT_EQ(status, 0);
-  EXPECT_EQ(probe, "h264,160,120,yuv420p,20/1,10\n");
-  // Stills at t = 0 and 0.5 s, the video's size.
-  for (const char* name : {"t_00000.000.png", "t_00000.500.png"}) {
+  EXPECT_EQ(probe, "h264,160,120,yuv420p,20/1,11\n");
+  // Stills at t = 0, 0.5 and 1 s, the video's size.
+  for (const char* name : {"t_00000.000.png", "t_00000.500.png", "t_00001.000.png"}) {
     const std::array<int, 2> size = PngSize((dir_ / "stills" / name).string());
     EXPECT_EQ(size[0], 160) << name;
     EXPECT_EQ(size[1], 120) << name;
   }
   int stills = 0;
   for (const auto& e : fs::directory_iterator(dir_ / "stills")) stills += e.is_regular_file();
-  EXPECT_EQ(stills, 2);
+  EXPECT_EQ(stills, 3);
 }
 
 // Stills are taken on the nearest frame: an interval shorter than a frame gives one still per
