@@ -22,8 +22,9 @@ bool SeabedFromGeom(const mjModel* m, Water* w, std::string* error) {
   }
   const int body = m->geom_bodyid[g];
   if (m->body_weldid[body] != 0 || m->body_mocapid[body] >= 0) {
-    return fail("the geom must be fixed in the world (on the world body or a body without "
-                "joints, not a mocap body)");
+    return fail(
+        "the geom must be fixed in the world (on the world body or a body without "
+        "joints, not a mocap body)");
   }
   // The geom's pose at qpos0 (it never moves).
   mjData* d = mj_makeData(m);
@@ -73,9 +74,8 @@ bool ResolveWater(const mjModel* m, const std::string& source, Water* w, std::st
   if (!w->current_profile.empty()) {
     const std::string& file = w->current_profile;
     const size_t slash = source.find_last_of('/');
-    const std::string path = file[0] == '/' || slash == std::string::npos
-                                 ? file
-                                 : source.substr(0, slash + 1) + file;
+    const std::string path =
+        file[0] == '/' || slash == std::string::npos ? file : source.substr(0, slash + 1) + file;
     std::optional<CurrentProfile> profile = ReadCurrentProfile(path, error);
     if (!profile) return false;
     w->profile = std::move(*profile);

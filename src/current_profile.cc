@@ -58,7 +58,8 @@ std::optional<CurrentProfile> ReadCurrentProfile(const std::string& path, std::s
     for (int i = 1; i < 4; ++i) {
       if (!(std::abs(v[i]) <= kMaxU)) {
         std::ostringstream o;
-        o << where << "u" << "xyz"[i - 1] << " = " << v[i] << " m/s outside [-1000, 1000]";
+        o << where << "u"
+          << "xyz"[i - 1] << " = " << v[i] << " m/s outside [-1000, 1000]";
         return fail(o.str());
       }
     }

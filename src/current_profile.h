@@ -4,12 +4,11 @@
 #ifndef MJTETHER_SRC_CURRENT_PROFILE_H_
 #define MJTETHER_SRC_CURRENT_PROFILE_H_
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace mjtether {
 

@@ -5,11 +5,10 @@
 #ifndef MJTETHER_SRC_SEABED_H_
 #define MJTETHER_SRC_SEABED_H_
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace mjtether {
 
@@ -45,7 +44,8 @@ struct SeabedSurface {
     const double sx = 2 * rx / (ncol - 1), sy = 2 * ry / (nrow - 1);  // [m] cell size
     const double a0 = (lx + rx) / sx, b0 = (ly + ry) / sy;
     const double a = std::clamp(a0, 0.0, ncol - 1.0), b = std::clamp(b0, 0.0, nrow - 1.0);
-    const int c = std::min(static_cast<int>(a), ncol - 2), r = std::min(static_cast<int>(b), nrow - 2);
+    const int c = std::min(static_cast<int>(a), ncol - 2),
+              r = std::min(static_cast<int>(b), nrow - 2);
     const double fa = a - c, fb = b - r;
     const double h00 = height[r * ncol + c], h01 = height[r * ncol + c + 1];
     const double h10 = height[(r + 1) * ncol + c], h11 = height[(r + 1) * ncol + c + 1];

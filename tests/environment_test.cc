@@ -4,13 +4,12 @@
 // reduce to.
 #include <gtest/gtest.h>
 
+#include <Eigen/LU>
 #include <cmath>
 #include <fstream>
 #include <functional>
 #include <iterator>
 #include <string>
-
-#include <Eigen/LU>
 
 #include "mujoco_fixture.h"
 
@@ -47,8 +46,8 @@ std::string WriteFile(const std::string& name, const std::string& text) {
 struct Sheared {
   double L = 20, d = 0.03, mu = 1.0, EA = 1e5, Cdn = 1.2, Cdt = 0.01;
   double rho = 1025, g = 9.81;
-  double M = 100, V = 0.02;          // vehicle [kg], [m^3]
-  double Dl = 20, Dq = 100;          // vehicle surge damping [N s/m], [N s^2/m^2]
+  double M = 100, V = 0.02;             // vehicle [kg], [m^3]
+  double Dl = 20, Dq = 100;             // vehicle surge damping [N s/m], [N s^2/m^2]
   double z0 = -25, u0 = 0.1, u1 = 0.7;  // profile rows (z0, u0) and (0, u1)
   double Ux(double z) const {
     if (z <= z0) return u0;
@@ -115,20 +114,24 @@ std::string ShearedScene(const Sheared& c, int N, const std::string& integrator,
 <mujoco>
   <option timestep="0.002"><flag contact="disable"/></option>
   <custom>
-    <text name="water" data=")" + water + R"("/>
-    <text name="tether:t" data="ends=top,rov length=)" + Fmt(c.L) + " segments=" +
-         std::to_string(N) + " diameter=" + Fmt(c.d) + " mass_per_length=" + Fmt(c.mu) +
-         " EA=" + Fmt(c.EA) + " damping=2000 Cdn=" + Fmt(c.Cdn) + " Cdt=" + Fmt(c.Cdt) +
-         " integrator=" + integrator + R"("/>
-    <text name="vehicle:rov" data="volume=)" + Fmt(c.V) + " linear_damping=" + Fmt(c.Dl) + "," +
-         Fmt(c.Dl) + R"(,2000,50,50,50 quadratic_damping=)" + Fmt(c.Dq) + "," + Fmt(c.Dq) +
+    <text name="water" data=")" +
+         water + R"("/>
+    <text name="tether:t" data="ends=top,rov length=)" +
+         Fmt(c.L) + " segments=" + std::to_string(N) + " diameter=" + Fmt(c.d) +
+         " mass_per_length=" + Fmt(c.mu) + " EA=" + Fmt(c.EA) + " damping=2000 Cdn=" + Fmt(c.Cdn) +
+         " Cdt=" + Fmt(c.Cdt) + " integrator=" + integrator + R"("/>
+    <text name="vehicle:rov" data="volume=)" +
+         Fmt(c.V) + " linear_damping=" + Fmt(c.Dl) + "," + Fmt(c.Dl) +
+         R"(,2000,50,50,50 quadratic_damping=)" + Fmt(c.Dq) + "," + Fmt(c.Dq) +
          R"(,100,10,10,10"/>
   </custom>
   <worldbody>
     <site name="top" pos="0 0 0"/>
-    <body name="rov" pos=")" + Fmt(x0) + " 0 " + Fmt(z0 == 0 ? -c.L : z0) + R"(">
+    <body name="rov" pos=")" +
+         Fmt(x0) + " 0 " + Fmt(z0 == 0 ? -c.L : z0) + R"(">
       <freejoint/>
-      <geom type="box" size="0.3 0.3 0.3" mass=")" + Fmt(c.M) + R"("/>
+      <geom type="box" size="0.3 0.3 0.3" mass=")" +
+         Fmt(c.M) + R"("/>
       <site name="rov"/>
     </body>
   </worldbody>
@@ -139,15 +142,15 @@ std::string ShearedScene(const Sheared& c, int N, const std::string& integrator,
 // (lower end = index 0), after `seconds` of simulation.
 double ShapeError(const Sheared& c, int N, const std::string& integrator, double seconds,
                   double* offset) {
-  const std::string csv = WriteFile("profile_sheared.csv", "z,ux,uy,uz\n" + Fmt(c.z0) + "," +
-                                                               Fmt(c.u0) + ",0,0\n0," +
-                                                               Fmt(c.u1) + ",0,0\n");
+  const std::string csv =
+      WriteFile("profile_sheared.csv",
+                "z,ux,uy,uz\n" + Fmt(c.z0) + "," + Fmt(c.u0) + ",0,0\n0," + Fmt(c.u1) + ",0,0\n");
   // The vehicle starts at the reference's lower end (the tether straight to it): the slowest
   // mode, the line swinging against drag and the vehicle's damping (time constant ~6 s),
   // then starts from centimetres, not metres, away.
   const std::vector<Eigen::Vector2d> ref = Equilibrium(c, N);
-  LoadedScene s(ShearedScene(c, N, integrator, "density=1025 current_profile=" + csv,
-                             ref[0].x(), ref[0].y()));
+  LoadedScene s(ShearedScene(c, N, integrator, "density=1025 current_profile=" + csv, ref[0].x(),
+                             ref[0].y()));
   if (!s.m) return 1e9;
   const int steps = static_cast<int>(seconds / s.m->opt.timestep);
   for (int k = 0; k < steps; ++k) {
@@ -233,16 +236,16 @@ TEST(CurrentProfileDeclaration, Refusals) {
   const Sheared c;
   const std::string csv = WriteFile("profile_ok.csv", "0,0.1,0,0\n");
   std::string error;
-  mjModel* m = LoadModelFromString(
-      ShearedScene(c, 5, "implicit", "current=0.1,0,0 current_profile=" + csv), "scene.xml",
-      &error);
+  mjModel* m =
+      LoadModelFromString(ShearedScene(c, 5, "implicit", "current=0.1,0,0 current_profile=" + csv),
+                          "scene.xml", &error);
   EXPECT_EQ(m, nullptr);
   EXPECT_NE(error.find("scene.xml: <text name=\"water\">"), std::string::npos) << error;
   EXPECT_NE(error.find("'current' and 'current_profile' exclude each other"), std::string::npos)
       << error;
   const std::string bad = WriteFile("profile_bad.csv", "z,ux,uy,uz\n0,0,0,0\n-1,0,0,0\n");
-  m = LoadModelFromString(ShearedScene(c, 5, "implicit", "current_profile=" + bad),
-                          "scene.xml", &error);
+  m = LoadModelFromString(ShearedScene(c, 5, "implicit", "current_profile=" + bad), "scene.xml",
+                          &error);
   EXPECT_EQ(m, nullptr);
   EXPECT_NE(error.find(bad + " line 3: z must increase strictly"), std::string::npos) << error;
 }
@@ -278,15 +281,19 @@ TEST_P(SeabedPlane, SlidesWhenTanAlphaExceedsMu) {
   <option timestep="0.002"><flag contact="disable"/></option>
   <compiler angle="radian"/>
   <custom>
-    <text name="water" data="density=1025 seabed=ground seabed_friction=)" + Fmt(mu) +
-                          " seabed_friction_speed=" + Fmt(eps) + R"("/>
+    <text name="water" data="density=1025 seabed=ground seabed_friction=)" +
+                          Fmt(mu) + " seabed_friction_speed=" + Fmt(eps) + R"("/>
     <text name="tether:t" data="ends=a,free length=2 segments=20 diameter=0.02
-      mass_per_length=2 EA=1e3 damping=1 integrator=)" + pc.integrator + R"("/>
+      mass_per_length=2 EA=1e3 damping=1 integrator=)" +
+                          pc.integrator + R"("/>
   </custom>
   <worldbody>
-    <geom name="ground" type="plane" size="10 10 0.1" euler="0 )" + Fmt(alpha) + R"( 0"/>
-    <body name="slider" pos=")" + Fmt(start.x()) + " 0 " + Fmt(start.z()) + R"(">
-      <joint name="s" type="slide" axis=")" + Fmt(down.x()) + " 0 " + Fmt(down.z()) + R"("/>
+    <geom name="ground" type="plane" size="10 10 0.1" euler="0 )" +
+                          Fmt(alpha) + R"( 0"/>
+    <body name="slider" pos=")" +
+                          Fmt(start.x()) + " 0 " + Fmt(start.z()) + R"(">
+      <joint name="s" type="slide" axis=")" +
+                          Fmt(down.x()) + " 0 " + Fmt(down.z()) + R"("/>
       <geom type="sphere" size="0.005" mass="0.05"/>
       <site name="a"/>
     </body>
@@ -315,12 +322,12 @@ TEST_P(SeabedPlane, SlidesWhenTanAlphaExceedsMu) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Cases, SeabedPlane,
-    ::testing::Values(PlaneCase{0.2, "implicit"}, PlaneCase{0.45, "implicit"},
-                      PlaneCase{0.2, "implicit2"}, PlaneCase{0.45, "implicit2"},
-                      PlaneCase{0.2, "explicit"}, PlaneCase{0.45, "explicit"},
-                      PlaneCase{0.2, "rk4"}, PlaneCase{0.45, "rk4"}));
+INSTANTIATE_TEST_SUITE_P(Cases, SeabedPlane,
+                         ::testing::Values(PlaneCase{0.2, "implicit"}, PlaneCase{0.45, "implicit"},
+                                           PlaneCase{0.2, "implicit2"},
+                                           PlaneCase{0.45, "implicit2"}, PlaneCase{0.2, "explicit"},
+                                           PlaneCase{0.45, "explicit"}, PlaneCase{0.2, "rk4"},
+                                           PlaneCase{0.45, "rk4"}));
 
 // Height field: models/seabed_hfield.xml (a sloping, rough hfield from a PNG, a 60 m tether
 // lying on it) settles, and every node is on or above the surface within the static
@@ -400,8 +407,10 @@ TEST_P(SeabedHfield, NodesRestOnTheSurface) {
   EXPECT_LT(vmax, 2 * w.seabed_friction_speed) << "not at rest after 30 s";
   RecordProperty("grounded", grounded);
   RecordProperty("worst_penetration_over_bound", Fmt(worst));
-  std::printf("hfield %s: %d nodes grounded, worst penetration %.3g of its bound, largest %.3g m, "
-              "vmax %.3g m/s\n", GetParam(), grounded, worst, pen_max, vmax);
+  std::printf(
+      "hfield %s: %d nodes grounded, worst penetration %.3g of its bound, largest %.3g m, "
+      "vmax %.3g m/s\n",
+      GetParam(), grounded, worst, pen_max, vmax);
   mj_deleteData(d);
   Detach(m2);
   mj_deleteModel(m2);
@@ -441,8 +450,7 @@ TEST(SeabedDeclaration, Refusals) {
   std::string error;
   EXPECT_TRUE(load("ground", &error)) << error;
   EXPECT_FALSE(load("grond", &error));
-  EXPECT_NE(error.find("key 'seabed' = 'grond': no geom of that name"), std::string::npos)
-      << error;
+  EXPECT_NE(error.find("key 'seabed' = 'grond': no geom of that name"), std::string::npos) << error;
   EXPECT_FALSE(load("ball", &error));
   EXPECT_NE(error.find("must be a plane or an hfield"), std::string::npos) << error;
   EXPECT_FALSE(load("raft", &error));

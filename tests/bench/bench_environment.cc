@@ -41,8 +41,10 @@ std::string Scene(int segments, const std::string& water) {
     <geom name="hf" type="hfield" hfield="flat" pos="0 0 -10"/>
   </worldbody>
   <custom>
-    <text name="water" data=")" + water + R"("/>
-    <text name="tether:t" data="ends=a,b length=20 segments=)" + std::to_string(segments) +
+    <text name="water" data=")" +
+         water + R"("/>
+    <text name="tether:t" data="ends=a,b length=20 segments=)" +
+         std::to_string(segments) +
          R"( diameter=0.03 mass_per_length=1 EA=1e5 EAc=1e5 EI=1 damping=100 Cdn=1.2 Cdt=0.01
       integrator=implicit"/>
   </custom>
