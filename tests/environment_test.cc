@@ -336,7 +336,9 @@ INSTANTIATE_TEST_SUITE_P(Cases, SeabedPlane,
 // the bending shear F_b (below), so its penetration is at most (w l_i + F_i + F_b) / (k l_i)
 // (plus 20 % for what is left of motion, and 1e-6 m): about 2e-5 m here. A wrong surface
 // (rows and columns swapped, the other diagonal, the wrong height scale) puts nodes
-// centimetres to metres off. At least 15 nodes must be on the ground (within 1 mm).
+// centimetres to metres off; and the surface the engine uses is checked against MuJoCo's own,
+// by a ray cast down onto the geom at every node (mj_ray, within 1e-6 m: float data). At
+// least 15 nodes must be on the ground (within 1 mm).
 class SeabedHfield : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(SeabedHfield, NodesRestOnTheSurface) {
@@ -372,12 +374,21 @@ TEST_P(SeabedHfield, NodesRestOnTheSurface) {
   const double k = w.seabed_stiffness;
   const double wl = std::abs(tether->node_weight(N / 2).z()) / tether->rest_segment_length();
   int grounded = 0;
-  double worst = 0, pen_max = 0;  // largest penetration / its bound, largest penetration [m]
+  double worst = 0, pen_max = 0,
+         ray_gap = 0;  // largest penetration / its bound, largest penetration [m]
   for (int i = 1; i < N; ++i) {
     vmax = std::max(vmax, Vec3(v + 3 * i).norm());
     double zs;
     Vec3 n;
     w.surface.Under(x[3 * i], x[3 * i + 1], &zs, &n);
+    // The engine's surface is MuJoCo's: a ray cast straight down onto the hfield geom (MuJoCo's
+    // own triangles, mj_ray) lands at the same height (to round-off; the data are floats).
+    const mjtNum from[3] = {x[3 * i], x[3 * i + 1], x[3 * i + 2] + 10}, down[3] = {0, 0, -1};
+    int geom = -1;
+    const double dist = mj_ray(m2, d, from, down, nullptr, 1, -1, &geom);
+    ASSERT_GE(dist, 0) << "node " << i;
+    EXPECT_NEAR(from[2] - dist, zs, 1e-6) << "node " << i;
+    ray_gap = std::max(ray_gap, std::abs(from[2] - dist - zs));
     const double pen = (zs - x[3 * i + 2]) * n.z();
     const Vec3 ta = (Vec3(x + 3 * i) - Vec3(x + 3 * i - 3)).normalized();
     const Vec3 tb = (Vec3(x + 3 * i + 3) - Vec3(x + 3 * i)).normalized();
