@@ -420,8 +420,8 @@ TEST_P(SeabedHfield, NodesRestOnTheSurface) {
   RecordProperty("worst_penetration_over_bound", Fmt(worst));
   std::printf(
       "hfield %s: %d nodes grounded, worst penetration %.3g of its bound, largest %.3g m, "
-      "vmax %.3g m/s\n",
-      GetParam(), grounded, worst, pen_max, vmax);
+      "vmax %.3g m/s, surface against mj_ray %.3g m\n",
+      GetParam(), grounded, worst, pen_max, vmax, ray_gap);
   mj_deleteData(d);
   Detach(m2);
   mj_deleteModel(m2);
