@@ -15,6 +15,7 @@
 
 #include "contact_glue.h"
 #include "declaration.h"
+#include "environment_glue.h"
 #include "mjtether.h"
 #include "model_files.h"
 #include "text_check.h"
@@ -536,12 +537,13 @@ bool CheckStart(const mjModel* m, const mjData* d, const Environment& env,
   std::ostringstream s;
   for (int end = 0; end < 2; ++end) {
     if (at.site[end] < 0 || !env.water.has_seabed) continue;
-    const double z = d->site_xpos[3 * at.site[end] + 2];
-    if (z < env.water.seabed) {
+    const mjtNum* xs = d->site_xpos + 3 * at.site[end];
+    const double z = xs[2], zb = env.water.SeabedHeight(xs[0], xs[1]);
+    if (z < zb) {
       s << "end " << end_name[end] << " (site '" << mj_id2name(m, mjOBJ_SITE, at.site[end])
-        << "') starts at z = " << z << " m, " << env.water.seabed - z
-        << " m below the seabed (water key 'seabed' = " << env.water.seabed
-        << " m): move the site or its body above the seabed, or lower the seabed";
+        << "') starts at z = " << z << " m, " << zb - z
+        << " m below the seabed (water key " << SeabedDescription(env.water)
+        << "): move the site or its body above the seabed, or lower the seabed";
       *error = s.str();
       return false;
     }
@@ -586,11 +588,12 @@ bool CheckVehicles(const mjModel* m, const mjData* d, const Environment& env,
     const int body = mj_name2id(m, mjOBJ_BODY, name.substr(8).c_str());
     if (body < 0) continue;  // AttachVehicles reports it
     const double z = d->xpos[3 * body + 2];
-    if (z < env.water.seabed) {
+    const double zb = env.water.SeabedHeight(d->xpos[3 * body], d->xpos[3 * body + 1]);
+    if (z < zb) {
       std::ostringstream s;
-      s << "body '" << name.substr(8) << "' starts at z = " << z << " m, "
-        << env.water.seabed - z << " m below the seabed (water key 'seabed' = "
-        << env.water.seabed << " m): move it above the seabed, or lower the seabed";
+      s << "body '" << name.substr(8) << "' starts at z = " << z << " m, " << zb - z
+        << " m below the seabed (water key " << SeabedDescription(env.water)
+        << "): move it above the seabed, or lower the seabed";
       *element = name;
       *error = s.str();
       return false;
@@ -694,10 +697,10 @@ std::string Diagnose(const mjModel* m, const mjData* d, const Environment& env,
   if (IsExplicit(p.integrator) && h / t.SubstepsFor(h) > t.ExplicitStableStep()) return "";
   if (env.water.has_seabed) {
     for (int end = 0; end < (both ? 2 : 1); ++end) {
-      if (pos[end].z() < env.water.seabed) {
+      const double zb = env.water.SeabedHeight(pos[end].x(), pos[end].y());
+      if (pos[end].z() < zb) {
         s << "seabed penetration: end " << end_name[end] << " (body '" << body_name(end)
-          << "') is " << env.water.seabed - pos[end].z()
-          << " m below the seabed (z = " << env.water.seabed
+          << "') is " << zb - pos[end].z() << " m below the seabed (z = " << zb
           << " m), pressing the tether into it; keep the body above the seabed";
         return s.str();
       }
@@ -845,6 +848,9 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
     if (!water) return fail("water", e.message);
     env.wet = true;
     env.water = *water;
+    // current_profile=FILE.csv and seabed=GEOMNAME (plugin/environment_glue.cc).
+    std::string message;
+    if (!ResolveWater(m, source, &env.water, &message)) return fail("water", message);
   }
 
   auto set = std::make_unique<ModelTethers>();

@@ -188,7 +188,7 @@ void ApplyVehicles(const mjModel* m, mjData* d) {
     if (!veh.has_damping() && !veh.has_added_mass()) continue;
     // Free joint: qvel = world velocity of the body origin, then body-frame angular velocity.
     const Vec3 v(d->qvel + av.dof), w(d->qvel + av.dof + 3);
-    const Vec6 nu_r = veh.RelativeVelocity(R, v, w);
+    const Vec6 nu_r = veh.RelativeVelocity(R, v, w, origin.z());
     Wrench tau = veh.Damping(nu_r);
     if (veh.has_added_mass()) {
       // The world acceleration over the last step, from the velocities at the last two

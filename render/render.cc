@@ -823,8 +823,9 @@ void Renderer::Decorate(const mjModel* m, const mjData* d, double D, bool overla
   if (TetherCount(m) == 0) return;
   const Water& w = GetTether(m, 0)->env().water;
 
-  // Seabed: a slab whose top is at the seabed height, under the camera's reference point.
-  if (w.has_seabed && seabed_geom_ < 0) {
+  // Seabed: a slab whose top is at the seabed height, under the camera's reference point
+  // (a seabed=GEOMNAME seabed is that geom, which MuJoCo draws).
+  if (w.has_seabed && seabed_geom_ < 0 && !w.surface.declared()) {
     if (mjvGeom* g = NextGeom(&scn_)) {
       const double thick = 0.01 * D;
       const mjtNum size[3] = {4 * D, 4 * D, thick};

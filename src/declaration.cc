@@ -1,8 +1,10 @@
 #include "declaration.h"
 
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <sstream>
 
 #include "text_check.h"
@@ -145,11 +147,26 @@ std::optional<KeyValues> SplitKeyValues(const std::string& text, DeclarationErro
   return pairs;
 }
 
+// A word that can name a geom: a letter or '_' first, then letters, digits and _ - . : /
+// (so "nan", "inf" and "0x10" stay numbers that are refused as such).
+static bool IsGeomName(const std::string& v) {
+  if (v.empty() || !(std::isalpha(static_cast<unsigned char>(v[0])) || v[0] == '_')) return false;
+  for (char ch : v) {
+    if (!(std::isalnum(static_cast<unsigned char>(ch)) || std::strchr("_-.:/", ch))) return false;
+  }
+  const std::string low = [&] {
+    std::string l;
+    for (char ch : v) l += static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    return l;
+  }();
+  return low != "nan" && low != "inf" && low != "infinity";
+}
+
 std::optional<Water> ParseWater(const std::string& text, DeclarationError* error) {
   static const char* const kKeys[] = {
       "density",          "current",         "seabed",
       "seabed_stiffness", "seabed_damping",  "seabed_friction",
-      "seabed_friction_axial", "seabed_friction_speed"};
+      "seabed_friction_axial", "seabed_friction_speed", "current_profile"};
   std::optional<KeyValues> pairs = SplitKeyValues(text, error);
   if (!pairs) return std::nullopt;
   Water w;
@@ -159,9 +176,23 @@ std::optional<Water> ParseWater(const std::string& text, DeclarationError* error
       ok = ParseInRange(key, value, {0, 1e4, true}, &w.density, error);
     } else if (key == "current") {
       ok = ParseVector(key, value, &w.current, error);
+    } else if (key == "current_profile") {
+      // Read by the MuJoCo glue, which knows the model's directory (ReadCurrentProfile).
+      if (value.size() < 5 || value.compare(value.size() - 4, 4, ".csv") != 0) {
+        ok = Fail(error, key,
+                  "key 'current_profile' = " + Shown(value) + ": expected a file name FILE.csv");
+      }
+      w.current_profile = value;
     } else if (key == "seabed") {
-      ok = ParseInRange(key, value, {-1.1e4, 1e4, false}, &w.seabed, error);
-      w.has_seabed = ok;
+      // A height [m], or the name of a plane or hfield geom (resolved by the MuJoCo glue).
+      double z;
+      if (ParseDecimal(value, &z) == NumberStatus::kNotNumber && IsGeomName(value)) {
+        w.seabed_geom = value;
+        w.has_seabed = true;
+      } else {
+        ok = ParseInRange(key, value, {-1.1e4, 1e4, false}, &w.seabed, error);
+        w.has_seabed = ok;
+      }
     } else if (key == "seabed_stiffness") {
       ok = ParseInRange(key, value, {0, 1e10, true}, &w.seabed_stiffness, error);
     } else if (key == "seabed_damping") {
@@ -186,8 +217,18 @@ std::optional<Water> ParseWater(const std::string& text, DeclarationError* error
     return std::nullopt;
   }
   if (w.seabed_friction_axial < 0) w.seabed_friction_axial = w.seabed_friction;
+  if (!w.current_profile.empty() && w.current.squaredNorm() > 0) {
+    Fail(error, "current_profile",
+         "keys 'current' and 'current_profile' exclude each other: give the uniform current as "
+         "a one-row profile, or drop 'current'");
+    return std::nullopt;
+  }
   return w;
 }
+
+// A current is declared: uniform and non-zero, or a profile (read or only named: the effects
+// are resolved before the glue reads the file in some callers).
+static bool HasCurrent(const Water& w) { return w.has_current() || !w.current_profile.empty(); }
 
 std::optional<unsigned> ResolveEffects(const TetherParams& p, const Environment& env,
                                        const std::string& effects_text, DeclarationError* error,
@@ -209,9 +250,9 @@ std::optional<unsigned> ResolveEffects(const TetherParams& p, const Environment&
       {wet && (p.Cdn > 0 || p.Cdt > 0), wet && (p.Cdn > 0 || p.Cdt > 0),
        "a water declaration and Cdn or Cdt > 0"},
       {wet && p.Can > 0, wet && p.Can > 0, "a water declaration and Can > 0"},
-      {wet && env.water.current.squaredNorm() > 0 && (p.Cdn > 0 || p.Cdt > 0),
-       wet && env.water.current.squaredNorm() > 0 && (p.Cdn > 0 || p.Cdt > 0),
-       "a non-zero water current and drag (Cdn or Cdt > 0)"},
+      {wet && HasCurrent(env.water) && (p.Cdn > 0 || p.Cdt > 0),
+       wet && HasCurrent(env.water) && (p.Cdn > 0 || p.Cdt > 0),
+       "a non-zero water current (or current_profile) and drag (Cdn or Cdt > 0)"},
       {wet && env.water.has_seabed, wet && env.water.has_seabed, "water seabed=Z"},
       {(p.clamp_a || p.clamp_b) && p.EI > 0, (p.clamp_a || p.clamp_b) && p.EI > 0,
        "clamp=A|B|both and EI > 0"},

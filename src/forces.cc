@@ -148,11 +148,15 @@ void Tether::NodeTangents(ConstNodes x, ConstNodes t, Nodes q) const {
 
 // Morison drag on the velocity relative to the current u, per unit length (length share
 // l_i = (l_{i-1} + l_i)/2, stretched):
-//   f_n = 1/2 rho Cdn d |vn| vn,   f_t = 1/2 rho Cdt pi d |vt| vt,   v_r = u - v_i.
-void Tether::AddDrag(ConstNodes v, ConstNodes q, const double* l, Nodes f) const {
-  const Vec3 u = Has(kCurrent) ? env_.water.current : Vec3::Zero();
+//   f_n = 1/2 rho Cdn d |vn| vn,   f_t = 1/2 rho Cdt pi d |vt| vt,   v_r = u(z_i) - v_i.
+// With a current profile each node sees the current at its own height z_i.
+void Tether::AddDrag(ConstNodes x, ConstNodes v, ConstNodes q, const double* l, Nodes f) const {
+  const bool current = Has(kCurrent);
+  const bool profile = current && !env_.water.profile.empty();
+  const Vec3 u0 = current ? env_.water.current : Vec3::Zero();
   for (int i = 0; i <= N_; ++i) {
     const double li = 0.5 * ((i > 0 ? l[i - 1] : 0) + (i < N_ ? l[i] : 0));
+    const Vec3 u = profile ? env_.water.profile.At(x(2, i)) : u0;
     const Vec3 vr = u - v.col(i);
     const Vec3 qi = q.col(i);
     const double vq = vr.dot(qi);  // |vt| = |vq|: q is a unit vector
@@ -173,6 +177,10 @@ void Tether::AddDrag(ConstNodes v, ConstNodes q, const double* l, Nodes f) const
 void Tether::AddSeabed(ConstNodes x, ConstNodes v, ConstNodes q, Nodes f,
                        const Start* start) const {
   const Water& w = env_.water;
+  if (w.surface.declared()) {
+    AddSeabedSurface(x, v, q, f, start);
+    return;
+  }
   for (int i = 0; i <= N_; ++i) {
     const double pen = w.seabed - x(2, i);
     if (pen <= 0) continue;
@@ -190,6 +198,43 @@ void Tether::AddSeabed(ConstNodes x, ConstNodes v, ConstNodes q, Nodes f,
                                     va.normalized();
     if (vc.norm() > 0) f.col(i) -= w.seabed_friction * N * std::tanh(vc.norm() / eps) *
                                    vc.normalized();
+  }
+}
+
+// Seabed that is a geom (a tilted plane or a height field, seabed.h): the same law with the
+// surface's height zs and upward normal n under the node. The penetration is the distance to
+// the surface's tangent plane, pen = (zs - z) n_z (exact for a plane and for the height
+// field's triangle under the node); N_i = max(0, k l_i pen - c l_i v.n) acts along n, and the
+// friction acts on the velocity in the tangent plane, split along and across the tether's
+// tangent projected on that plane.
+void Tether::AddSeabedSurface(ConstNodes x, ConstNodes v, ConstNodes q, Nodes f,
+                              const Start* start) const {
+  const Water& w = env_.water;
+  for (int i = 0; i <= N_; ++i) {
+    double zs;
+    Vec3 n;
+    w.surface.Under(x(0, i), x(1, i), &zs, &n);
+    const double pen = (zs - x(2, i)) * n.z();
+    if (pen <= 0) continue;
+    double sink = -v.col(i).dot(n);  // [m/s]
+    if (start) {
+      // Above the surface at the step's start: the sink rate limited to pen/h (see AddSeabed).
+      double zs0;
+      Vec3 n0;
+      w.surface.Under(start->x(0, i), start->x(1, i), &zs0, &n0);
+      if (start->x(2, i) >= zs0) sink = std::min(sink, pen / start->h);
+    }
+    const double Nk = std::max(0.0, share_(i) * (seabed_k_ * pen + seabed_c_ * sink));
+    f.col(i) += Nk * n;
+    if (w.seabed_friction == 0 && w.seabed_friction_axial == 0) continue;
+    Vec3 qh = q.col(i) - q.col(i).dot(n) * n;
+    qh = qh.norm() > 1e-12 ? Vec3(qh.normalized()) : Vec3::Zero();
+    const Vec3 vh = v.col(i) - v.col(i).dot(n) * n;
+    const Vec3 va = vh.dot(qh) * qh, vc = vh - va;
+    const double eps = w.seabed_friction_speed;
+    const double mu_a = w.seabed_friction_axial, mu_c = w.seabed_friction;
+    if (va.norm() > 0) f.col(i) -= (mu_a * Nk * std::tanh(va.norm() / eps) / va.norm()) * va;
+    if (vc.norm() > 0) f.col(i) -= (mu_c * Nk * std::tanh(vc.norm() / eps) / vc.norm()) * vc;
   }
 }
 
@@ -277,7 +322,7 @@ void Tether::Forces(const double* xp, const double* vp, const Ends& ends, double
   }
   if (Has(kWeight) || Has(kBuoyancy)) f += weight_;
   if (Has(kDrag) || Has(kAddedMass) || Has(kSeabed)) NodeTangents(x, tc, q);
-  if (Has(kDrag)) AddDrag(v, qc, w.l, f);
+  if (Has(kDrag)) AddDrag(x, v, qc, w.l, f);
   if (Has(kSeabed)) AddSeabed(x, v, qc, f, start);
   if (Has(kContact) && ends.contacts) AddContact(x, v, ends, f);
 }

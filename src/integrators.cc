@@ -283,10 +283,16 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
       }
     }
     // Drag: d(|vn| vn)/dv_r = |vn| P + vn vn^T/|vn|, d(|vt| vt)/dv_r = 2 |vt| q q^T; B = -h D.
+    // With a current profile u(z): the current at the node's height, and its derivative
+    // du/dz (a stiffness h^2 df/dz through z) left out of the Jacobian: it changes the Newton
+    // iteration's rate, not its fixed point (docs/environment.md).
     if (Has(kDrag)) {
-      const Vec3 u = Has(kCurrent) ? env_.water.current : Vec3::Zero();
+      const bool current = Has(kCurrent);
+      const bool profile = current && !env_.water.profile.empty();
+      const Vec3 u0 = current ? env_.water.current : Vec3::Zero();
       for (int i = 1; i <= nu; ++i) {
         const double li = 0.5 * (w.l[i - 1] + (i < N_ ? w.l[i] : 0));
+        const Vec3 u = profile ? env_.water.profile.At(xk(2, i)) : u0;
         const Vec3 qi = q.col(i);
         const Vec3 vr = u - vk.col(i);
         const double vq = vr.dot(qi);
@@ -300,7 +306,28 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
       }
     }
     // Seabed: normal stiffness and damping, friction secant.
-    if (Has(kSeabed)) {
+    if (Has(kSeabed) && env_.water.surface.declared()) {
+      // A geom seabed: the same along the surface's normal n, (h^2 k + h c) l_i n n^T, and the
+      // friction secant in its tangent plane, (I - n n^T).
+      const Water& wt = env_.water;
+      for (int i = 1; i <= nu; ++i) {
+        double zs;
+        Vec3 n;
+        wt.surface.Under(xk(0, i), xk(1, i), &zs, &n);
+        const double pen = (zs - xk(2, i)) * n.z();
+        if (pen <= 0) continue;
+        BlockBand::Block d = A.D(i - 1);
+        const Mat3 nn = n * n.transpose();
+        d += (h2 * seabed_k_ * share_(i) + h * seabed_c_ * share_(i)) * nn;
+        const double N =
+            std::max(0.0, share_(i) * (seabed_k_ * pen - seabed_c_ * vk.col(i).dot(n)));
+        const double mu = std::max(wt.seabed_friction, wt.seabed_friction_axial);
+        const double vh = (vk.col(i) - vk.col(i).dot(n) * n).norm();
+        const double eps = wt.seabed_friction_speed;
+        const double secant = vh > 1e-9 * eps ? mu * N * std::tanh(vh / eps) / vh : mu * N / eps;
+        d += (h * secant) * (Mat3::Identity() - nn);
+      }
+    } else if (Has(kSeabed)) {
       const Water& wt = env_.water;
       for (int i = 1; i <= nu; ++i) {
         const double pen = wt.seabed - xk(2, i);
@@ -625,7 +652,7 @@ double Tether::EnergyBound(const Ends& from, const Ends& to) const {
   const double L = p_.length;
   double v = std::max(from.a.vel.norm(), to.a.vel.norm());
   if (!p_.free_end) v = std::max({v, from.b.vel.norm(), to.b.vel.norm()});
-  if (Has(kCurrent)) v += env_.water.current.norm();
+  if (Has(kCurrent)) v += env_.water.MaxCurrentSpeed();
   const double M = mass_.sum() + added_.sum();
   double E = 0.5 * p_.EA * p_.max_strain * p_.max_strain * L + 0.5 * M * v * v;
   if (Has(kBending)) E += 0.5 * p_.EI * (4 / (L0_ * L0_)) * L;

@@ -10,6 +10,9 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "current_profile.h"
+#include "seabed.h"
+
 namespace mjtether {
 
 using Vec3 = Eigen::Vector3d;
@@ -69,13 +72,32 @@ inline const char* IntegratorName(Integrator i) {
 struct Water {
   double density = 1025;         // [kg/m^3]
   Vec3 current = Vec3::Zero();   // [m/s] uniform current velocity, world frame
+  // A depth profile (`current_profile=FILE.csv`) instead of the uniform current: the file as
+  // declared, and its rows once read (by the MuJoCo glue, relative to the model's directory).
+  std::string current_profile;
+  CurrentProfile profile;
   bool has_seabed = false;       // a flat seabed was declared
   double seabed = 0;             // [m] height (world z) of the seabed plane
+  // seabed=GEOMNAME: a plane or hfield geom is the seabed; its surface, filled by the MuJoCo
+  // glue at load (seabed.h). `seabed` above is then unused.
+  std::string seabed_geom;
+  SeabedSurface surface;
   double seabed_stiffness = 1e5;  // [N/m^2] normal force per length of tether per penetration
   double seabed_damping = -1;    // [N s/m^2] per length; < 0: critical for the tether's mass
   double seabed_friction = 0;    // [-] Coulomb coefficient across the tether
   double seabed_friction_axial = -1;  // [-] along the tether; < 0: same as seabed_friction
   double seabed_friction_speed = 0.01;  // [m/s] slip speed over which friction saturates (tanh)
+
+  // A current is declared: uniform and non-zero, or a profile.
+  bool has_current() const { return !profile.empty() || current.squaredNorm() > 0; }
+  // The current [m/s] at height z [m] (world frame).
+  Vec3 CurrentAt(double z) const { return profile.empty() ? current : profile.At(z); }
+  // Height of the seabed [m] under (x, y): the flat seabed's, or the geom's surface.
+  double SeabedHeight(double x, double y) const {
+    return surface.declared() ? surface.HeightUnder(x, y) : seabed;
+  }
+  // Largest current speed anywhere [m/s].
+  double MaxCurrentSpeed() const { return profile.empty() ? current.norm() : profile.MaxSpeed(); }
 };
 
 struct TetherParams {

@@ -319,8 +319,26 @@ void Tether::InitialShape(const Ends& ends, double* xp, double* vp) const {
 // needs the net weight along -z (a horizontal seabed under ordinary gravity); otherwise (or
 // for an end below the seabed, which the MuJoCo glue refuses at load) the nodes are only
 // lifted onto the seabed. A free end hangs down to the seabed and lies along its site's axis.
+//
+// A geom seabed (seabed.h) is met approximately: the shape above for a flat seabed at the
+// lower of the surface heights under the ends, then every node still below the surface
+// lifted vertically onto it (which stretches the segments over rough ground a little).
 void Tether::RestOnSeabed(const Ends& ends, Nodes x) const {
-  const double zb = env_.water.seabed;
+  const Water& w = env_.water;
+  if (!w.surface.declared()) {
+    RestOnLevel(ends, w.seabed, x);
+    return;
+  }
+  double zb = w.SeabedHeight(ends.a.pos.x(), ends.a.pos.y());
+  if (!p_.free_end) zb = std::min(zb, w.SeabedHeight(ends.b.pos.x(), ends.b.pos.y()));
+  RestOnLevel(ends, zb, x);
+  for (int k = 1; k <= N_; ++k) {
+    if (k == N_ && !p_.free_end) break;
+    x(2, k) = std::max(x(2, k), w.SeabedHeight(x(0, k), x(1, k)));
+  }
+}
+
+void Tether::RestOnLevel(const Ends& ends, double zb, Nodes x) const {
   const double L = p_.length;
   bool below = false;
   for (int k = 0; k <= N_ && !below; ++k) below = x(2, k) < zb;

@@ -177,8 +177,10 @@ class Tether {
   void BendingMoments(ConstNodes t, const Ends& ends, Nodes M) const;
   void AddBending(ConstNodes t, const double* l, ConstNodes M, Nodes f) const;
   void NodeTangents(ConstNodes x, ConstNodes t, Nodes q) const;
-  void AddDrag(ConstNodes v, ConstNodes q, const double* l, Nodes f) const;
+  void AddDrag(ConstNodes x, ConstNodes v, ConstNodes q, const double* l, Nodes f) const;
   void AddSeabed(ConstNodes x, ConstNodes v, ConstNodes q, Nodes f, const Start* start) const;
+  void AddSeabedSurface(ConstNodes x, ConstNodes v, ConstNodes q, Nodes f,
+                        const Start* start) const;
   Vec3 ContactForce(const ContactPoint& c, const double* xp, const double* vp, double dt_ref,
                     double* normal_force) const;
   void AddContact(ConstNodes x, ConstNodes v, const Ends& ends, Nodes f) const;
@@ -186,6 +188,7 @@ class Tether {
                                 bool to_stage) const;
 
   void RestOnSeabed(const Ends& ends, Nodes x) const;
+  void RestOnLevel(const Ends& ends, double zb, Nodes x) const;
 
   // Integrators (one step of size h; ends already set at the start, `next` at the end).
   void PlaceEnds(const Ends& e, Nodes x, Nodes v) const;

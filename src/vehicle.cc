@@ -43,9 +43,10 @@ std::optional<Vehicle> Vehicle::Create(const VehicleParams& params, const Enviro
   return v;
 }
 
-Vec6 Vehicle::RelativeVelocity(const Eigen::Matrix3d& R, const Vec3& v, const Vec3& w) const {
+Vec6 Vehicle::RelativeVelocity(const Eigen::Matrix3d& R, const Vec3& v, const Vec3& w,
+                               double z) const {
   Vec6 nu_r;
-  nu_r.head<3>() = R.transpose() * (v - env_.water.current);
+  nu_r.head<3>() = R.transpose() * (v - env_.water.CurrentAt(z));
   nu_r.tail<3>() = w;
   return nu_r;
 }

@@ -86,9 +86,12 @@ class Vehicle {
   // Buoyancy force [N], world frame: -rho V g. Apply it at the cob.
   Vec3 Buoyancy() const { return buoyancy_force_; }
 
-  // Body-frame velocity of the body origin relative to the water: v_r = R^T (v - u), w.
-  // R (body to world), v [m/s] world velocity of the body origin, w [rad/s] body frame.
-  Vec6 RelativeVelocity(const Eigen::Matrix3d& R, const Vec3& v, const Vec3& w) const;
+  // Body-frame velocity of the body origin relative to the water: v_r = R^T (v - u(z)), w.
+  // R (body to world), v [m/s] world velocity of the body origin, w [rad/s] body frame, z [m]
+  // the origin's height (the current at the vehicle's own depth with a current profile; the
+  // profile's shear across the hull and the water's acceleration du/dz dz/dt are left out).
+  Vec6 RelativeVelocity(const Eigen::Matrix3d& R, const Vec3& v, const Vec3& w,
+                        double z) const;
 
   // Damping -(D_l + D_q |nu_r|) nu_r, body frame, about the body origin.
   Wrench Damping(const Vec6& nu_r) const;

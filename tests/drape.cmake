@@ -1,0 +1,5 @@
+# Tether-geom contact beyond contact_test: a drape over a frictionless cylinder with a mass on
+# one end, against statics (docs/environment.md).
+add_executable(drape_test drape_test.cc)
+target_link_libraries(drape_test PRIVATE mjtether_plugin GTest::gtest_main)
+gtest_discover_tests(drape_test DISCOVERY_TIMEOUT 60 PROPERTIES LABELS contact)
