@@ -367,7 +367,8 @@ void Renderer::PlaceCamera(const mjModel* m, const mjData* d) {
   for (int k = 0; k < TetherCount(m); ++k) {
     const double* x = NodePositions(m, d, k);
     if (!x) continue;
-    for (int i = 0; i < GetTether(m, k)->nodes(); ++i) add(x + 3 * i);
+    // The deployed nodes only (with a winch, those before first_node are on the drum).
+    for (int i = GetWinch(m, d, k).first_node; i < GetTether(m, k)->nodes(); ++i) add(x + 3 * i);
   }
   if (vehicle_ >= 0) add(d->xpos + 3 * vehicle_);
   const Vec3 lookat = lo.x() <= hi.x() ? Vec3(0.5 * (lo + hi)) : Vec3(m->stat.center);
@@ -396,7 +397,7 @@ void Renderer::Decorate(const mjModel* m, const mjData* d) {
       T.resize(t.segments());
       GetTensions(m, d, k, T.data());
       const double radius = DrawnRadius(t, D);
-      for (int j = 0; j < t.segments(); ++j) {
+      for (int j = GetWinch(m, d, k).first_node; j < t.segments(); ++j) {  // deployed only
         const double* a = x + 3 * j;
         const double* b = x + 3 * j + 3;
         if (mju_dist3(a, b) < 1e-9) continue;
@@ -456,6 +457,12 @@ void Renderer::DrawHud(const mjModel* m, const mjData* d) {
     values += buf;
     titles += "\n" + name + ": T at end A (" + BodyName(m, EndBody(m, k, 0)) + ")\n" + name +
               ": T at end B (" + BodyName(m, EndBody(m, k, 1)) + ")";
+    const WinchState w = GetWinch(m, d, k);
+    if (w.present) {
+      std::snprintf(buf, sizeof(buf), "\n%.2f m (%+.2f m/s)", w.length, w.payout_speed);
+      values += buf;
+      titles += "\n" + name + ": deployed (payout)";
+    }
   }
   if (vehicle_ >= 0) {
     std::snprintf(buf, sizeof(buf), "\n%.2f m", -d->xpos[3 * vehicle_ + 2]);

@@ -77,22 +77,31 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
   const double rho = env.wet ? env.water.density : 0;
 
   // Lumped masses: half of each adjacent segment.
-  c.share_ = Eigen::VectorXd::Constant(n, c.L0_);
-  c.share_(0) = c.share_(c.N_) = c.L0_ / 2;
-  c.mass_ = params.mass_per_length * c.share_;
-  c.added_ = c.Has(kAddedMass) ? Eigen::VectorXd(params.Can * rho * c.area_ * c.share_)
-                               : Eigen::VectorXd::Zero(n);
-  c.inv_mass_ = c.mass_.cwiseInverse();
+  auto arrays = std::make_shared<NodeArrays>();
+  NodeArrays& a = *arrays;
+  a.share = Eigen::VectorXd::Constant(n, c.L0_);
+  a.share(0) = a.share(c.N_) = c.L0_ / 2;
+  a.mass = params.mass_per_length * a.share;
+  a.added = c.Has(kAddedMass) ? Eigen::VectorXd(params.Can * rho * c.area_ * a.share)
+                              : Eigen::VectorXd::Zero(n);
+  a.inv_mass = a.mass.cwiseInverse();
   c.damping_per_L0_ = params.damping / c.L0_;
-  c.inv_mass_normal_ = (c.mass_ + c.added_).cwiseInverse();
+  a.inv_mass_normal = (a.mass + a.added).cwiseInverse();
   // Net weight: dry weight minus buoyancy of the displaced volume.
-  c.weight_ = Eigen::Matrix3Xd::Zero(3, n);
+  a.weight = Eigen::Matrix3Xd::Zero(3, n);
   for (int i = 0; i < n; ++i) {
     double m = 0;
-    if (c.Has(kWeight)) m += c.mass_(i);
-    if (c.Has(kBuoyancy)) m -= rho * c.area_ * c.share_(i);
-    c.weight_.col(i) = m * env.gravity;
+    if (c.Has(kWeight)) m += a.mass(i);
+    if (c.Has(kBuoyancy)) m -= rho * c.area_ * a.share(i);
+    a.weight.col(i) = m * env.gravity;
   }
+  c.mass_ = a.mass.data();
+  c.added_ = a.added.data();
+  c.inv_mass_ = a.inv_mass.data();
+  c.inv_mass_normal_ = a.inv_mass_normal.data();
+  c.share_ = a.share.data();
+  c.weight_ = a.weight.data();
+  c.arrays_ = std::move(arrays);
   // Morison drag per unit length: 1/2 rho Cdn d |vn| vn and 1/2 rho Cdt pi d |vt| vt.
   c.kn_ = 0.5 * rho * params.Cdn * params.diameter;
   c.kt_ = 0.5 * rho * params.Cdt * kPi * params.diameter;
@@ -116,11 +125,19 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
   // segments push back), fourth difference 16 EI/(L0^3 m) (doubled when an
   // end is clamped, whose curvature weight is L0/2), seabed k l / m. Damping (internal,
   // seabed, friction) shortens the limit of symplectic Euler to 2/w (sqrt(1+z^2) - z).
+  // With a winch the shortest segment is the winch segment at its shortest, L0/2: the limit
+  // is that of a tether of segments L0/2 throughout (node masses halved with them).
   double m_min = INFINITY, mn_min = INFINITY;
   for (int i = 0; i < n; ++i) {
     if (!c.Dynamic(i)) continue;
-    m_min = std::min(m_min, c.mass_(i));
-    mn_min = std::min(mn_min, c.mass_(i) + c.added_(i));
+    m_min = std::min(m_min, c.mass_[i]);
+    mn_min = std::min(mn_min, c.mass_[i] + c.added_[i]);
+  }
+  const double L0_save = c.L0_;
+  if (params.winch) {
+    c.L0_ *= 0.5;
+    m_min *= 0.5;
+    mn_min *= 0.5;
   }
   if (!std::isfinite(m_min)) {
     c.explicit_dt_ = INFINITY;  // no dynamic node (one segment between two sites)
@@ -138,7 +155,7 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
     if (c.Has(kSeabed)) {
       rate += c.seabed_c_ * c.L0_ / m_min;
       const double mu = std::max(env.water.seabed_friction, env.water.seabed_friction_axial);
-      const double wet = c.weight_.col(1 % n).norm() / std::max(c.share_(1 % n), 1e-300);
+      const double wet = c.Weight(1 % n).norm() / std::max(c.share_[1 % n], 1e-300);
       rate += mu * wet * c.L0_ / (env.water.seabed_friction_speed * m_min);
     }
     if (c.Has(kContact)) rate += c.contact_c_ * c.L0_ / m_min;
@@ -148,12 +165,14 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
                                             ? Rk4StableStep(w, zeta)
                                             : 2 / w * (std::sqrt(1 + zeta * zeta) - zeta));
   }
+  c.L0_ = L0_save;
   // The 3-node window for the end reactions: rest length L0 per segment, so its end nodes
   // carry the same lumped length, mass, weight and curvature weights as the tether's.
   if (c.N_ >= 3) {
     TetherParams wp = params;
     wp.segments = 2;
     wp.length = 2 * c.L0_;
+    wp.winch = false;
     std::optional<Tether> window = Create(wp, env, error);
     if (!window) return std::nullopt;
     c.window_ = std::make_shared<const Tether>(std::move(*window));
@@ -184,7 +203,7 @@ void Tether::InitialShape(const Ends& ends, double* xp, double* vp) const {
   const Vec3 A = ends.a.pos;
   const double L = p_.length;
   // "Down" is the way the net weight pulls; without weight, gravity's way; without gravity, -z.
-  Vec3 down = weight_.col(0).norm() > 0 ? Vec3(weight_.col(0).normalized())
+  Vec3 down = Weight(0).norm() > 0 ? Vec3(Weight(0).normalized())
               : env_.gravity.norm() > 0 ? Vec3(env_.gravity.normalized())
                                         : Vec3(0, 0, -1);
   if (p_.free_end) {
@@ -311,7 +330,7 @@ void Tether::RestOnSeabed(const Ends& ends, Nodes x) const {
   bool below = false;
   for (int k = 0; k <= N_ && !below; ++k) below = x(2, k) < zb;
   if (!below) return;
-  const Vec3 g = weight_.col(0).norm() > 0 ? Vec3(weight_.col(0)) : env_.gravity;
+  const Vec3 g = Weight(0).norm() > 0 ? Weight(0) : env_.gravity;
   const bool vertical = g.norm() > 0 && -g.z() >= (1 - 1e-9) * g.norm();
   const Vec3& A = ends.a.pos;
   const Vec3 ez = Vec3::UnitZ();
