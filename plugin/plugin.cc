@@ -812,8 +812,8 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
       }
       // At most one node inserted or removed per tether step (Tether::Advance).
       if (!(w.max_speed * m->opt.timestep <= 0.25 * L0)) {
-        s << "key 'max_speed' = " << w.max_speed << " m/s pays out " << w.max_speed * m->opt.timestep
-          << " m per <option timestep> " << m->opt.timestep << " s, more than a quarter segment ("
+        s << "key 'max_speed' = " << w.max_speed << " m/s pays out "
+          << w.max_speed * m->opt.timestep << " m per <option timestep> " << m->opt.timestep << " s, more than a quarter segment ("
           << 0.25 * L0 << " m); allowed: (0, " << 0.25 * L0 / m->opt.timestep << "] m/s";
         return fail(wname, s.str());
       }
