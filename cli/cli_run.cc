@@ -101,6 +101,10 @@ int Run(const RunOptions& opt) {
       for (const char* column : {".tension_A", ".tension_B", ".tension_max", ".slack_segments"}) {
         head += "," + CsvField(n + column);
       }
+      // A winch (docs/winch.md): deployed unstretched length [m] and payout speed [m/s].
+      if (mjtether::GetWinch(mm, d, k).present) {
+        for (const char* column : {".length", ".payout_speed"}) head += "," + CsvField(n + column);
+      }
     }
     log.Write(head + "\n");
   }
@@ -127,11 +131,13 @@ int Run(const RunOptions& opt) {
         mjtether::GetTensions(mm, o, k, T.data());
         double tmax = 0;
         int slack = 0;
-        for (double t : T) {
-          tmax = std::max(tmax, t);
-          slack += t <= 0;
+        const mjtether::WinchState w = mjtether::GetWinch(mm, o, k);
+        for (size_t j = w.present ? w.first_node : 0; j < T.size(); ++j) {  // deployed only
+          tmax = std::max(tmax, T[j]);
+          slack += T[j] <= 0;
         }
         row << "," << r.tension_a << "," << r.tension_b << "," << tmax << "," << slack;
+        if (w.present) row << "," << w.length << "," << w.payout_speed;
       }
       row << "\n";
       log.Write(row.str());
@@ -145,7 +151,8 @@ int Run(const RunOptions& opt) {
         mjtether::GetTensions(mm, o, k, T.data());
         std::ostringstream rows_k;
         rows_k.precision(opt.digits);
-        for (int i = 0; i < t->nodes(); ++i) {
+        const mjtether::WinchState w = mjtether::GetWinch(mm, o, k);
+        for (int i = w.present ? w.first_node : 0; i < t->nodes(); ++i) {  // deployed only
           rows_k << o->time << "," << name << "," << i << "," << x[3 * i] << "," << x[3 * i + 1]
                  << "," << x[3 * i + 2] << "," << T[std::min(i, t->segments() - 1)] << "\n";
         }

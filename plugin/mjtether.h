@@ -104,6 +104,20 @@ EndReactions GetReactions(const mjModel* m, const mjData* d, int k);
 // one of a tether with EAc, reads 0.
 void GetTensions(const mjModel* m, const mjData* d, int k, double* T);
 
+// Winch (docs/winch.md). For a tether without one, present is false and length is the
+// declared length. With one, the node arrays (NodePositions) hold the allocation for
+// max_length; nodes before first_node are on the drum (at its site), and the deployed tether
+// runs from first_node to the last node (node 0 of the arrays is at the drum's end: with
+// end=B the arrays run from end B).
+struct WinchState {
+  bool present = false;
+  double length = 0;        // [m] deployed unstretched length
+  double payout_speed = 0;  // [m/s] drum speed over the last step, > 0 paying out
+  int segments = 0;         // [-] deployed (active) segments
+  int first_node = 0;       // [-] index of the drum-exit node
+};
+WinchState GetWinch(const mjModel* m, const mjData* d, int k);
+
 // Contact (docs/contact.md): the impulse [N s] the geoms gave tether k over its last advance
 // (the bodies received its opposite), and the candidates left out for lack of room then.
 Vec3 ContactImpulse(const mjModel* m, const mjData* d, int k);

@@ -20,6 +20,7 @@
 #include "model_files.h"
 #include "text_check.h"
 #include "vehicle_glue.h"
+#include "winch_declaration.h"
 
 namespace mjtether {
 namespace {
@@ -55,6 +56,9 @@ enum Slot : int {
 // A contact reaction record: body, force on it [N] (3), point of application [m] (3), applied
 // at every callback until the next advance replaces them.
 constexpr int kContactRecord = 7;
+// With a winch, after the state: the drum's deployed length [m], payout speed [m/s] and the
+// index of the drum-exit node (Payout::first).
+enum WinchSlot : int { kWinchLength = 0, kWinchSpeed, kWinchFirst, kWinchSlots };
 
 // Per end attached to a body that moves (docs/coupling.md), from kCoupleA or kCoupleB: the
 // work balance of the coupling, for the chatter check.
@@ -84,7 +88,30 @@ struct AttachedTether {
   // force explicitly over its step (docs/coupling.md).
   bool coupled[2] = {false, false};
   CouplingLimit limit[2];  // the time-step advisor's figures at load time
+  // A winch (winch:NAME, docs/winch.md) at internal end A (sites swapped when declared at B).
+  bool winch = false;
+  bool swapped = false;            // the winch is at the declared end B
+  WinchParams winch_params;
+  int actuator = -1;               // whose ctrl commands it
+  double initial_length = 0;       // [m] deployed at the start (the tether's `length`)
+  int winch_offset = 0;            // start of the winch slots in userdata
 };
+
+// The deployed unstretched length [m]: the winch's, else the declared length.
+double DeployedLength(const AttachedTether& at, const double* u) {
+  return at.winch ? u[at.winch_offset - at.offset + kWinchLength] : at.tether.params().length;
+}
+
+// The deployment stored in d (a tether with a winch).
+Payout LoadPayout(const AttachedTether& at, const double* u) {
+  const double* w = u + (at.winch_offset - at.offset);
+  Payout p;
+  p.first = static_cast<int>(w[kWinchFirst]);
+  p.speed = w[kWinchSpeed];
+  const double L0 = at.tether.rest_segment_length();
+  p.rest = w[kWinchLength] - (at.tether.segments() - p.first - 1) * L0;
+  return p;
+}
 
 // Doubles of mjData stack for one step's contact candidates.
 int ContactWorkSize(const AttachedTether& at) {
@@ -242,15 +269,38 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
   const double step = d->time - u[kTime];
   bool advanced = false, restarted = false;
   double given[2] = {0, 0};  // [J] work the tether's end forces did on the sites this advance
+  double* wu = u + (at.winch_offset - at.offset);  // winch slots (unused without a winch)
   if (u[kInitialized] == 0 || d->time < u[kTime] || Teleported(at, now, u, d->time)) {
     restarted = true;
     // First call, reset, time went back, or an end was teleported: start again from the
     // declared initial shape.
-    tether.InitialShape(now, x, v);
+    if (at.winch) {
+      // The deployed part from the drum exit, the rest on the drum (at site A). A restart
+      // keeps the deployment; a reset (kInitialized = 0) restores the declared one.
+      const double L0 = tether.rest_segment_length();
+      if (u[kInitialized] == 0) {
+        wu[kWinchLength] = at.initial_length;
+        wu[kWinchSpeed] = 0;
+        wu[kWinchFirst] = tether.segments() - std::lround(at.initial_length / L0);
+      }
+      const Payout p = LoadPayout(at, u);
+      const Tether view = tether.Deployed(p.first, p.rest, 0);
+      now.rest = p.rest;
+      view.InitialShape(now, x + 3 * p.first, v + 3 * p.first);
+      for (int i = 0; i < p.first; ++i) {
+        for (int c = 0; c < 3; ++c) {
+          x[3 * i + c] = now.a.pos[c];
+          v[3 * i + c] = now.a.vel[c];
+        }
+      }
+    } else {
+      tether.InitialShape(now, x, v);
+    }
     u[kInitialized] = 1;
     u[kStartTime] = d->time;
     u[kStartStrain] =
-        free_end ? 0 : std::max(0.0, (now.b.pos - now.a.pos).norm() / tether.params().length - 1);
+        free_end ? 0
+                 : std::max(0.0, (now.b.pos - now.a.pos).norm() / DeployedLength(at, u) - 1);
     u[kTime] = u[kPrevTime] = d->time;
     StoreEnd(now.a, u + kEndA);
     StoreEnd(now.b, u + kEndB);
@@ -272,7 +322,23 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
       now.time = d->time;
       from.contacts = now.contacts = &set;
     }
-    StepStatus status = tether.Advance(x, v, from, now, dt, work);
+    StepStatus status;
+    if (at.winch) {
+      // The drum's speed over this step from ctrl, the tension at the drum (last reaction)
+      // and the limits; the length then grows by exactly speed dt.
+      DrumState drum{wu[kWinchLength], wu[kWinchSpeed]};
+      const double ctrl = d->ctrl[at.actuator];
+      const double drum_tension = at.swapped ? u[kTensionB] : u[kTensionA];
+      const double speed = WinchSpeed(at.winch_params, drum, ctrl, drum_tension, dt);
+      Payout p = LoadPayout(at, u);
+      p.speed = speed;
+      status = tether.Advance(x, v, from, now, dt, work, &p);
+      wu[kWinchLength] = drum.length + speed * dt;
+      wu[kWinchSpeed] = speed;
+      wu[kWinchFirst] = p.first;
+    } else {
+      status = tether.Advance(x, v, from, now, dt, work);
+    }
     if (!status.ok) {
       u[kStatus] = status.reason.rfind("strain", 0) == 0    ? kStrain
                    : status.reason.rfind("kinetic", 0) == 0 ? kKinetic
@@ -337,7 +403,15 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
   // Reactions from the state and the sites as they are at this call (no contact candidates:
   // the end nodes' contact share is in the state's last advance, and in the records above).
   now.contacts = nullptr;
-  EndReactions r = tether.Reactions(x, v, now, work);
+  EndReactions r;
+  if (at.winch) {
+    const Payout p = LoadPayout(at, u);
+    const Tether view = tether.Deployed(p.first, p.rest, p.speed);
+    now.rest = p.rest;
+    r = view.Reactions(x + 3 * p.first, v + 3 * p.first, now, work);
+  } else {
+    r = tether.Reactions(x, v, now, work);
+  }
   if (at.contact) {
     r.force_a += Vec3(u + kContactEndA);
     r.tension_a = r.force_a.norm();
@@ -379,14 +453,26 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
     std::fill(u + kCoupleB, u + kCoupleB + kCoupleSize, 0.0);
   }
   double* cache = u + kForceA;
-  for (int i = 0; i < 3; ++i) {
-    cache[i] = r.force_a[i];
-    cache[3 + i] = r.torque_a[i];
-    cache[6 + i] = r.force_b[i];
-    cache[9 + i] = r.torque_b[i];
+  // Stored as declared: a winch at end B runs internally as end A.
+  const EndReactions& ra = r;
+  EndReactions rs;
+  if (at.swapped) {
+    rs.force_a = r.force_b;
+    rs.torque_a = r.torque_b;
+    rs.force_b = r.force_a;
+    rs.torque_b = r.torque_a;
+    rs.tension_a = r.tension_b;
+    rs.tension_b = r.tension_a;
   }
-  u[kTensionA] = r.tension_a;
-  u[kTensionB] = r.tension_b;
+  const EndReactions& stored = at.swapped ? rs : ra;
+  for (int i = 0; i < 3; ++i) {
+    cache[i] = stored.force_a[i];
+    cache[3 + i] = stored.torque_a[i];
+    cache[6 + i] = stored.force_b[i];
+    cache[9 + i] = stored.torque_b[i];
+  }
+  u[kTensionA] = stored.tension_a;
+  u[kTensionB] = stored.tension_b;
   if (at.body[0] > 0 && !at.mocap[0]) {
     mj_applyFT(m, d, r.force_a.data(), r.torque_a.data(), d->site_xpos + 3 * at.site[0],
                at.body[0], d->qfrc_passive);
@@ -532,7 +618,8 @@ bool CheckParameters(const TetherParams& p, bool wet, std::string* error) {
 // about a stretched start with the strain and the tension it means.
 bool CheckStart(const mjModel* m, const mjData* d, const Environment& env,
                 const AttachedTether& at, std::string* warning, std::string* error) {
-  const TetherParams& p = at.tether.params();
+  TetherParams p = at.tether.params();
+  if (at.winch) p.length = at.initial_length;
   const char* end_name[2] = {"A", "B"};
   std::ostringstream s;
   for (int end = 0; end < 2; ++end) {
@@ -620,7 +707,8 @@ std::string Diagnose(const mjModel* m, const mjData* d, const Environment& env,
                      const AttachedTether& at, const double* u) {
   constexpr int kStartSteps = 50;
   const Tether& t = at.tether;
-  const TetherParams& p = t.params();
+  TetherParams p = t.params();
+  p.length = DeployedLength(at, u);
   const double holds = p.EA * p.max_strain;  // [N] tension at max_strain
   const char* end_name[2] = {"A", "B"};
   std::ostringstream s;
@@ -853,6 +941,27 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
     if (!ResolveWater(m, source, &env.water, &message)) return fail("water", message);
   }
 
+  // Winches (winch:NAME), keyed by the tether's name; each must name a tether.
+  std::unordered_map<std::string, std::pair<std::string, WinchParams>> winches;
+  for (int i = 0; i < m->ntext; ++i) {
+    const std::string name = TextName(m, i);
+    if (name.rfind("winch:", 0) != 0) continue;
+    DeclarationError e;
+    std::optional<WinchParams> w = ParseWinch(TextData(m, i), &e);
+    if (!w) return fail(name, e.message);
+    const std::string tether = name.substr(6);
+    if (mj_name2id(m, mjOBJ_TEXT, ("tether:" + tether).c_str()) < 0) {
+      return fail(name, "no <text name=\"tether:" + tether +
+                            "\"> in the model: a winch names the tether it pays out");
+    }
+    if (mj_name2id(m, mjOBJ_ACTUATOR, w->actuator.c_str()) < 0) {
+      return fail(name, "key 'actuator': no actuator named '" + w->actuator +
+                            "' in the model (its ctrl commands the winch; declare one, e.g. "
+                            "<general name=\"" + w->actuator + "\" joint=... gear=\"0\"/>)");
+    }
+    winches[tether] = {name, *w};
+  }
+
   auto set = std::make_unique<ModelTethers>();
   set->source = source;
   set->env = env;
@@ -866,6 +975,58 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
     if (!decl) return fail(name, e.message);
     if (name.size() == 7) return fail(name, "a tether needs a name after 'tether:'");
     std::string message;
+    // A winch: the state is allocated for max_length (docs/winch.md).
+    const auto winch = winches.find(name.substr(7));
+    double initial_length = 0;
+    if (winch != winches.end()) {
+      const std::string& wname = winch->second.first;
+      const WinchParams& w = winch->second.second;
+      TetherParams& p = decl->params;
+      const double L0 = p.length / p.segments;
+      std::ostringstream s;
+      if (w.end == 1 && decl->site_b.empty()) {
+        return fail(wname, "key 'end' = B: end B of tether '" + name.substr(7) +
+                               "' is free; the winch's end must be attached (end=A)");
+      }
+      if (p.effects & kContact) {
+        return fail(wname, "a winch with the contact effect is not supported yet; remove "
+                           "contact= from <text name=\"" + name + "\">");
+      }
+      if (!(p.length >= w.min_length && p.length <= w.max_length)) {
+        s << "key 'min_length'/'max_length': the tether's length " << p.length
+          << " m (the deployed length at the start) is outside [" << w.min_length << ", "
+          << w.max_length << "] m";
+        return fail(wname, s.str());
+      }
+      if (!(w.min_length >= L0)) {
+        s << "key 'min_length' = " << w.min_length << " m is shorter than one segment, "
+          << L0 << " m (length / segments of the tether); allowed: [" << L0 << ", "
+          << w.max_length << "] m";
+        return fail(wname, s.str());
+      }
+      const double nmax = std::floor(w.max_length / L0 + 0.5) + 2;
+      if (!(nmax <= 1e5)) {
+        s << "key 'max_length' = " << w.max_length << " m needs " << nmax
+          << " segments of " << L0 << " m, more than 100000; allowed: [" << w.min_length
+          << ", " << 1e5 * L0 << "] m, or longer segments";
+        return fail(wname, s.str());
+      }
+      // At most one node inserted or removed per tether step (Tether::Advance).
+      if (!(w.max_speed * m->opt.timestep <= 0.25 * L0)) {
+        s << "key 'max_speed' = " << w.max_speed << " m/s pays out "
+          << w.max_speed * m->opt.timestep << " m per <option timestep> " << m->opt.timestep << " s, more than a quarter segment ("
+          << 0.25 * L0 << " m); allowed: (0, " << 0.25 * L0 / m->opt.timestep << "] m/s";
+        return fail(wname, s.str());
+      }
+      initial_length = p.length;
+      p.segments = static_cast<int>(nmax);
+      p.length = p.segments * L0;
+      p.winch = true;
+      if (w.end == 1) {
+        std::swap(decl->site_a, decl->site_b);
+        std::swap(p.clamp_a, p.clamp_b);
+      }
+    }
     std::optional<Tether> tether = Tether::Create(decl->params, env, &message);
     if (!tether) return fail(name, message);
     if (!CheckParameters(decl->params, env.wet, &message)) return fail(name, message);
@@ -883,6 +1044,13 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
     }
     AttachedTether at(name.substr(7), *tether);
     at.contact = (tether->params().effects & kContact) != 0;
+    if (winch != winches.end()) {
+      at.winch = true;
+      at.winch_params = winch->second.second;
+      at.swapped = at.winch_params.end == 1;
+      at.actuator = mj_name2id(m, mjOBJ_ACTUATOR, at.winch_params.actuator.c_str());
+      at.initial_length = initial_length;
+    }
     const std::string sites[2] = {decl->site_a, decl->site_b};
     for (int end = 0; end < 2; ++end) {
       if (sites[end].empty()) continue;  // free end B
@@ -922,11 +1090,13 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
       }
     }
     const long long block = kHeader + static_cast<long long>(tether->StateSize()) +
-                            (at.contact ? kContactRecord * at.contacts.capacity : 0);
+                            (at.contact ? kContactRecord * at.contacts.capacity : 0) +
+                            (at.winch ? kWinchSlots : 0);
     if (offset + block > 1'000'000'000LL) {
       return fail(name, "the tethers need more than 1e9 doubles of state: fewer segments");
     }
     at.offset = offset;
+    at.winch_offset = offset + static_cast<int>(block) - (at.winch ? kWinchSlots : 0);
     offset += static_cast<int>(block);
     set->work_size =
         std::max(set->work_size, tether->WorkspaceSize() + ContactWorkSize(at));
@@ -1113,7 +1283,40 @@ void GetTensions(const mjModel* m, const mjData* d, int k, double* T) {
     std::fill(T, T + tether->segments(), 0.0);
     return;
   }
+  const ModelTethers* set = Lookup(m);
+  const AttachedTether& at = set->tethers[k];
+  if (at.winch) {
+    // Segments on the drum read 0; the deployed ones from the Deployed view.
+    const Payout p = LoadPayout(at, d->userdata + at.offset);
+    std::fill(T, T + p.first, 0.0);
+    const Tether view = tether->Deployed(p.first, p.rest, p.speed);
+    view.Tensions(x + 3 * p.first, x + 3 * tether->nodes() + 3 * p.first, T + p.first);
+    return;
+  }
   tether->Tensions(x, x + 3 * tether->nodes(), T);
+}
+
+WinchState GetWinch(const mjModel* m, const mjData* d, int k) {
+  WinchState w;
+  const ModelTethers* set = Lookup(m);
+  if (!set || k < 0 || k >= static_cast<int>(set->tethers.size())) return w;
+  const AttachedTether& at = set->tethers[k];
+  const double* u = d->userdata + at.offset;
+  w.length = DeployedLength(at, u);
+  w.segments = at.tether.segments();
+  if (!at.winch) return w;
+  w.present = true;
+  if (u[kInitialized] == 0) {
+    w.length = at.initial_length;
+    w.segments = static_cast<int>(std::lround(at.initial_length / at.tether.rest_segment_length()));
+    w.first_node = at.tether.segments() - w.segments;
+    return w;
+  }
+  const Payout p = LoadPayout(at, u);
+  w.payout_speed = p.speed;
+  w.first_node = p.first;
+  w.segments = at.tether.segments() - p.first;
+  return w;
 }
 
 Vec3 ContactImpulse(const mjModel* m, const mjData* d, int k) {

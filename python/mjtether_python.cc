@@ -332,8 +332,25 @@ PYBIND11_MODULE(mjtether, mod) {
       .def_property_readonly("length", &TetherView::Length,
                              "current length along the nodes [m] (stretched)")
       .def_property_readonly(
-          "rest_length", [](const TetherView& t) { return t.tether()->params().length; },
-          "declared unstretched length [m]")
+          "rest_length",
+          [](const TetherView& t) {
+            return mjtether::GetWinch(t.sim->m(), t.sim->d(), t.k).length;
+          },
+          "unstretched length [m]: the declared one, or the deployed one with a winch")
+      .def_property_readonly(
+          "winch",
+          [](const TetherView& t) -> py::object {
+            const mjtether::WinchState w = mjtether::GetWinch(t.sim->m(), t.sim->d(), t.k);
+            if (!w.present) return py::none();
+            py::dict out;
+            out["length"] = w.length;
+            out["payout_speed"] = w.payout_speed;
+            out["segments"] = w.segments;
+            out["first_node"] = w.first_node;
+            return out;
+          },
+          "None, or the winch's state (docs/winch.md): deployed length [m], payout_speed "
+          "[m/s], deployed segments, first_node (nodes before it are on the drum)")
       .def_property_readonly(
           "time",
           [](const TetherView& t) { return mjtether::TetherTime(t.sim->m(), t.sim->d(), t.k); },

@@ -276,7 +276,9 @@ std::vector<Vec3> ScenePoints(const mjModel* m, const mjData* d, const std::vect
   for (int k = 0; k < TetherCount(m); ++k) {
     const double* x = NodePositions(m, d, k);
     if (!x) continue;
-    for (int i = 0; i < GetTether(m, k)->nodes(); ++i) pts.emplace_back(x + 3 * i);
+    // The deployed nodes only (with a winch, those before first_node are on the drum).
+    for (int i = GetWinch(m, d, k).first_node; i < GetTether(m, k)->nodes(); ++i)
+      pts.emplace_back(x + 3 * i);
   }
   for (int b : bodies) {
     const Vec3 c(d->xpos + 3 * b);
@@ -561,6 +563,7 @@ static std::vector<std::string> HudTitles(const mjModel* m, int vehicle, bool co
     for (int end = 0; end < 2; ++end) {
       t.push_back(prefix + (compact ? "T " : "T at ") + BodyName(m, EndBody(m, k, end)));
     }
+    if (GetTether(m, k)->params().winch) t.push_back(prefix + (compact ? "out" : "deployed"));
   }
   if (vehicle >= 0) {
     t.push_back(compact ? "depth" : "depth of " + BodyName(m, vehicle));
@@ -803,7 +806,7 @@ void Renderer::Decorate(const mjModel* m, const mjData* d, double D, bool overla
       T.resize(tether.segments());
       GetTensions(m, d, k, T.data());
       const double radius = DrawnRadius(tether, D);
-      for (int j = 0; j < tether.segments(); ++j) {
+      for (int j = GetWinch(m, d, k).first_node; j < tether.segments(); ++j) {  // deployed only
         const double* a = x + 3 * j;
         const double* b = x + 3 * j + 3;
         if (mju_dist3(a, b) < 1e-9) continue;
@@ -887,6 +890,11 @@ void Renderer::DrawHud(const mjModel* m, const mjData* d) {
     const EndReactions r = GetReactions(m, d, k);
     for (double T : {r.tension_a, r.tension_b}) {
       std::snprintf(buf, sizeof(buf), "%.1f N", T);
+      values.push_back(buf);
+    }
+    const WinchState w = GetWinch(m, d, k);
+    if (w.present) {  // its title: HudTitles
+      std::snprintf(buf, sizeof(buf), "%.2f m", w.length);
       values.push_back(buf);
     }
   }

@@ -63,7 +63,7 @@ inline double Tether::AxialForce(double eps, const Vec3& t, const Vec3& dv,
 }
 
 void Tether::AddAxial(ConstNodes x, ConstNodes v, ConstNodes t, const double* l, double* T,
-                      Nodes f, const Start* start) const {
+                      Nodes f, const Start* start, double rest0) const {
   (void)x;
   const double inv_L0 = 1 / L0_;  // [1/m]
   const double L0sq = L0_ * L0_;
@@ -71,6 +71,30 @@ void Tether::AddAxial(ConstNodes x, ConstNodes v, ConstNodes t, const double* l,
   for (int j = 0; j < N_; ++j) {
     double engage_h = 0;
     Vec3 dv = v.col(j + 1) - v.col(j);
+    if (j == 0 && head_) {
+      // The winch segment, rest length r = rest0 growing at the payout speed s: strain
+      // l/r - 1, strain rate d(l/r)/dt = t.(dv - (l/r) s t)/r: the velocity difference
+      // relative to the material leaving the drum, (l/r) s along t (docs/winch.md). The rate
+      // goes to AxialForce as L0 deps/dt.
+      const double r = rest0, lr = l[0] / r;
+      dv = (L0_ / r) * (dv - (lr * speed_) * t.col(0));
+      if (engaging) {
+        const double rs = std::max(r - speed_ * start->h, 1e-9 * L0_);  // rest at the start
+        const double es = (start->x.col(1) - start->x.col(0)).norm() / rs - 1;
+        const double e = lr - 1;
+        if (e > 0 ? es <= 0 : e < 0 && es >= 0) engage_h = start->h;
+        if (start->discrete) {
+          const double from = e > 0 ? std::max(es, 0.0) : std::min(es, 0.0);
+          dv = t.col(0) * (L0_ * (e - from) / start->h);
+          engage_h = 0;
+        }
+      }
+      const double Tj = AxialForce(lr - 1, t.col(0), dv, engage_h);
+      T[0] = std::max(Tj, 0.0);
+      f.col(0) += Tj * t.col(0);
+      f.col(1) -= Tj * t.col(0);
+      continue;
+    }
     if (engaging) {
       // On the other side of L0 at the start of the step than now?
       const double ls2 = (start->x.col(j + 1) - start->x.col(j)).squaredNorm();
@@ -111,13 +135,13 @@ void Tether::BendingMoments(ConstNodes t, const Ends& ends, Nodes M) const {
   };
   M.setZero();
   for (int i = 1; i < N_; ++i) {
-    M.col(i) = moment(t.col(i - 1), t.col(i), L0_);
+    M.col(i) = moment(t.col(i - 1), t.col(i), CurvatureWeight(i));
   }
   if (Has(kClamp) && p_.clamp_a) {
-    M.col(0) = moment(ends.a.axis, t.col(0), 0.5 * L0_);
+    M.col(0) = moment(ends.a.axis, t.col(0), 0.5 * rest_length(0));
   }
   if (Has(kClamp) && p_.clamp_b) {
-    M.col(N_) = moment(t.col(N_ - 1), ends.b.axis, 0.5 * L0_);
+    M.col(N_) = moment(t.col(N_ - 1), ends.b.axis, 0.5 * rest_length(N_ - 1));
   }
 }
 
@@ -186,7 +210,7 @@ void Tether::AddSeabed(ConstNodes x, ConstNodes v, ConstNodes q, Nodes f,
     if (pen <= 0) continue;
     double sink = -v(2, i);  // [m/s]
     if (start && start->x(2, i) >= w.seabed) sink = std::min(sink, pen / start->h);
-    const double N = std::max(0.0, share_(i) * (seabed_k_ * pen + seabed_c_ * sink));
+    const double N = std::max(0.0, Share(i) * (seabed_k_ * pen + seabed_c_ * sink));
     f(2, i) += N;
     if (w.seabed_friction == 0 && w.seabed_friction_axial == 0) continue;
     Vec3 qh(q(0, i), q(1, i), 0);
@@ -257,7 +281,7 @@ Vec3 Tether::ContactForce(const ContactPoint& c, const double* xp, const double*
   if (!(gap < 0)) return Vec3::Zero();
   const Vec3 vrel = (1 - s) * v.col(j) + s * v.col(j + 1) - c.velocity;
   const double vn = c.normal.dot(vrel);
-  const double N = std::max(0.0, L0_ * (contact_k_ * -gap - contact_c_ * vn));
+  const double N = std::max(0.0, rest_length(j) * (contact_k_ * -gap - contact_c_ * vn));
   *normal_force = N;
   Vec3 F = N * c.normal;
   if (p_.contact_friction > 0 && N > 0) {
@@ -315,12 +339,20 @@ void Tether::Forces(const double* xp, const double* vp, const Ends& ends, double
   f.setZero();
   SegmentGeometry(x, t, w.l);
   std::fill(T, T + N_, 0.0);
-  if (Has(kAxial)) AddAxial(x, v, tc, w.l, T, f, start);
+  if (Has(kAxial)) {
+    AddAxial(x, v, tc, w.l, T, f, start, head_ ? (ends.rest > 0 ? ends.rest : rest_) : L0_);
+  }
   if (Has(kBending)) {
     BendingMoments(tc, ends, M);
     AddBending(tc, w.l, Mc, f);
   }
-  if (Has(kWeight) || Has(kBuoyancy)) f += weight_;
+  if (Has(kWeight) || Has(kBuoyancy)) {
+    if (head_) {
+      for (int i = 0; i <= N_; ++i) f.col(i) += Weight(i);
+    } else {
+      f += WeightMatrix();
+    }
+  }
   if (Has(kDrag) || Has(kAddedMass) || Has(kSeabed)) NodeTangents(x, tc, q);
   if (Has(kDrag)) AddDrag(x, v, qc, w.l, f);
   if (Has(kSeabed)) AddSeabed(x, v, qc, f, start);
@@ -331,10 +363,13 @@ EndReactions Tether::Reactions(const double* xp, const double* vp, const Ends& e
                                double* work) const {
   Work w(work, N_);
   const int n = N_ + 1;
-  if (window_) {
+  if (window_ && N_ >= 3) {
     // Each end from its 3-node window: the force on an end node involves only its segment,
     // the curvature at its neighbour (the segment after) and its own drag, weight and seabed.
-    const Tether& wt = *window_;
+    // With a winch, end A's window has the winch segment's rest length.
+    std::optional<Tether> wa;
+    if (head_) wa.emplace(window_->Deployed(0, rest_, speed_));
+    const Tether& wt = head_ ? *wa : *window_;
     double* io = work + Work::Size(N_);
     double *wx = io, *wv = io + 9, *wf = io + 18, *wT = io + 27;
     double* scratch = io + kWindowIo;
@@ -364,6 +399,7 @@ EndReactions Tether::Reactions(const double* xp, const double* vp, const Ends& e
     X.rightCols(2) = x.middleCols(1, 2);
     V.rightCols(2) = v.middleCols(1, 2);
     wt.ComputeForces(wx, wv, we, wf, wT, scratch);
+    const Tether& wt_b = *window_;
     r.force_a = F.col(0) + contact_on_node(0);
     r.tension_a = r.force_a.norm();
     if (Has(kClamp) && p_.clamp_a) r.torque_a = M.col(0);
@@ -371,7 +407,8 @@ EndReactions Tether::Reactions(const double* xp, const double* vp, const Ends& e
     V.leftCols(2) = v.middleCols(N_ - 2, 2);
     X.col(2) = p_.free_end ? Vec3(x.col(N_)) : ends.b.pos;
     V.col(2) = p_.free_end ? Vec3(v.col(N_)) : ends.b.vel;
-    wt.ComputeForces(wx, wv, we, wf, wT, scratch);
+    we.rest = 0;
+    wt_b.ComputeForces(wx, wv, we, wf, wT, scratch);
     if (p_.free_end) {
       r.tension_b = wT[1];
     } else {
@@ -418,6 +455,15 @@ void Tether::Tensions(const double* xp, const double* vp, double* T) const {
     const Vec3 dx = x.col(j + 1) - x.col(j);
     const double l = dx.norm();
     T[j] = 0;
+    if (j == 0 && head_) {
+      // The winch segment (see AddAxial), at the view's rest length.
+      if (Has(kAxial) && l > rest_) {
+        const Vec3 t = dx * (1 / l);
+        const Vec3 dv = (L0_ / rest_) * (v.col(1) - v.col(0) - (l / rest_ * speed_) * t);
+        T[0] = AxialForce(l / rest_ - 1, t, dv, 0);
+      }
+      continue;
+    }
     if (Has(kAxial) && l > L0_) {
       T[j] = AxialForce(l * inv_L0 - 1, dx * (1 / l), v.col(j + 1) - v.col(j), 0);
     }
@@ -428,12 +474,12 @@ double Tether::KineticEnergy(const double* xp, const double* vp) const {
   ConstNodes x(xp, 3, N_ + 1), v(vp, 3, N_ + 1);
   double E = 0;
   for (int i = 0; i <= N_; ++i) {
-    E += 0.5 * mass_(i) * v.col(i).squaredNorm();
-    if (added_(i) > 0) {
+    E += 0.5 * Mass(i) * v.col(i).squaredNorm();
+    if (Added(i) > 0) {
       Vec3 s = x.col(std::min(i + 1, N_)) - x.col(std::max(i - 1, 0));
       Vec3 q = s.norm() > 0 ? Vec3(s.normalized()) : Vec3::Zero();
       Vec3 vn = v.col(i) - v.col(i).dot(q) * q;
-      E += 0.5 * added_(i) * vn.squaredNorm();
+      E += 0.5 * Added(i) * vn.squaredNorm();
     }
   }
   return E;
@@ -446,8 +492,9 @@ double Tether::PotentialEnergy(const double* xp, const Ends& ends) const {
   for (int j = 0; j < N_; ++j) {
     Vec3 dx = x.col(j + 1) - x.col(j);
     const double l = dx.norm();
-    if (Has(kAxial) && l > L0_) E += 0.5 * p_.EA / L0_ * (l - L0_) * (l - L0_);
-    if (Has(kCompression) && l < L0_) E += 0.5 * p_.EAc / L0_ * (l - L0_) * (l - L0_);
+    const double L0 = rest_length(j);
+    if (Has(kAxial) && l > L0) E += 0.5 * p_.EA / L0 * (l - L0) * (l - L0);
+    if (Has(kCompression) && l < L0) E += 0.5 * p_.EAc / L0 * (l - L0) * (l - L0);
     Vec3 t = l > 0 ? Vec3(dx / l) : Vec3::Zero();
     // Bending: the potential of the forces of AddBending is EI/w (1 - cos theta) per node
     // (theta the turning angle, w the curvature weight), since M = EI sin(theta)/w.
@@ -458,13 +505,13 @@ double Tether::PotentialEnergy(const double* xp, const Ends& ends) const {
         if (p_.bending != Bending::kDER) return p_.EI / w * (1 - c);
         return 2 * p_.EI / w * (1 - c) / std::max(1 + c, 1e-2);
       };
-      if (j > 0) E += energy(t_prev, t, L0_);
-      if (j == 0 && Has(kClamp) && p_.clamp_a) E += energy(ends.a.axis, t, 0.5 * L0_);
-      if (j == N_ - 1 && Has(kClamp) && p_.clamp_b) E += energy(t, ends.b.axis, 0.5 * L0_);
+      if (j > 0) E += energy(t_prev, t, CurvatureWeight(j));
+      if (j == 0 && Has(kClamp) && p_.clamp_a) E += energy(ends.a.axis, t, 0.5 * L0);
+      if (j == N_ - 1 && Has(kClamp) && p_.clamp_b) E += energy(t, ends.b.axis, 0.5 * L0);
     }
     t_prev = t;
   }
-  for (int i = 0; i <= N_; ++i) E -= weight_.col(i).dot(x.col(i));
+  for (int i = 0; i <= N_; ++i) E -= Weight(i).dot(x.col(i));
   return E;
 }
 

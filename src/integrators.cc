@@ -25,12 +25,13 @@ EndState Interpolate(const EndState& e0, const EndState& e1, double dt, double s
   return e;
 }
 
+}  // namespace
+
 Ends Interpolate(const Ends& from, const Ends& to, double dt, double s) {
   return {Interpolate(from.a, to.a, dt, s), Interpolate(from.b, to.b, dt, s),
-          from.time + s * (to.time - from.time), to.contacts};
+          from.time + s * (to.time - from.time), to.contacts,
+          from.rest + s * (to.rest - from.rest)};
 }
-
-}  // namespace
 
 // ---------------------------------------------------------------------------------------------
 // Integrators
@@ -48,9 +49,9 @@ void Tether::PlaceEnds(const Ends& e, Nodes x, Nodes v) const {
 // Acceleration of dynamic node i under force fi [N], node tangent qi: with normal added mass
 // the node mass matrix is m I + ma (I - q q^T), whose inverse is q q^T/m + (I - q q^T)/(m + ma).
 inline Vec3 Tether::Acceleration(int i, const Vec3& fi, const Vec3& qi) const {
-  if (!Has(kAddedMass)) return inv_mass_(i) * fi;
+  if (!Has(kAddedMass)) return InvMass(i) * fi;
   const Vec3 ft = fi.dot(qi) * qi;
-  return inv_mass_(i) * ft + inv_mass_normal_(i) * (fi - ft);
+  return InvMass(i) * ft + InvMassNormal(i) * (fi - ft);
 }
 
 // Symplectic (semi-implicit) Euler: v += h M^-1 f(x, v); x += h v.
@@ -191,15 +192,15 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
     double phi = 0, worst = 0;
     for (int i = 1; i <= nu; ++i) {
       const Vec3 dvi = vk.col(i) - v.col(i);
-      Vec3 r = h * f.col(i) - mass_(i) * dvi;
+      Vec3 r = h * f.col(i) - Mass(i) * dvi;
       if (added) {
         const Vec3 qi = q.col(i);
-        r -= added_(i) * (dvi - qi.dot(dvi) * qi);
+        r -= Added(i) * (dvi - qi.dot(dvi) * qi);
       }
       rhs.col(i - 1) = r;
       const double r2 = r.squaredNorm();
-      phi += r2 * inv_mass_(i);
-      worst = std::max(worst, r2 * inv_mass_(i) * inv_mass_(i));
+      phi += r2 * InvMass(i);
+      worst = std::max(worst, r2 * InvMass(i) * InvMass(i));
     }
     *err = std::sqrt(worst);
     return phi;
@@ -214,9 +215,9 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
       BlockBand::Block d = A.D(i - 1);
       if (added) {
         const Vec3 qi = q.col(i);
-        d = mass_(i) * I + added_(i) * (I - qi * qi.transpose());
+        d = Mass(i) * I + Added(i) * (I - qi * qi.transpose());
       } else {
-        d.diagonal().setConstant(mass_(i));
+        d.diagonal().setConstant(Mass(i));
       }
     }
     // Axial stiffness and damping of taut segments: B = h D + h^2 K with
@@ -226,13 +227,15 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
     // damping while it pushes, without the geometric term -|T|/l (I - t t^T): that negative
     // stiffness (buckling) would make the matrix indefinite, and bending carries it instead.
     if (Has(kAxial)) {
-      const double ka = p_.EA / L0_;
-      const double kc = p_.EAc / L0_;
-      const double ca = Has(kDamping) ? p_.damping / L0_ : 0;
       const bool compression = Has(kCompression);
       for (int j = 0; j < N_; ++j) {
-        const bool taut = w.l[j] > L0_;
-        if (!taut && !(compression && w.l[j] > 0 && w.l[j] < L0_)) continue;
+        // The winch segment (a Deployed view) at its rest length at the end of the step.
+        const double L0 = j == 0 && head_ ? WinchRest(next) : L0_;
+        const double ka = p_.EA / L0;
+        const double kc = p_.EAc / L0;
+        const double ca = Has(kDamping) ? p_.damping / L0 : 0;
+        const bool taut = w.l[j] > L0;
+        if (!taut && !(compression && w.l[j] > 0 && w.l[j] < L0)) continue;
         const Vec3 tj = t.col(j);
         Mat3 B;
         if (taut) {
@@ -245,8 +248,8 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
           const double along = h2 * ka + (w.T[j] > 0 ? h * ca : 0) - geo;
           B = along * tj * tj.transpose() + geo * I;
         } else {
-          const double rate = tj.dot(vk.col(j + 1) - vk.col(j)) / L0_;  // [1/s] deps/dt
-          const bool pushes = p_.EAc * (w.l[j] / L0_ - 1) + ca * L0_ * rate < 0;
+          const double rate = tj.dot(vk.col(j + 1) - vk.col(j)) / L0;  // [1/s] deps/dt
+          const bool pushes = p_.EAc * (w.l[j] / L0 - 1) + ca * L0 * rate < 0;
           B = (h2 * kc + (pushes ? h * ca : 0)) * tj * tj.transpose();
         }
         const bool d0 = Dynamic(j), d1 = Dynamic(j + 1);
@@ -273,9 +276,9 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         }
       };
       const double g3[3] = {1, -2, 1}, g2[2] = {-1, 1};
-      for (int i = 1; i < N_; ++i) stencil(i - 1, g3, 3, L0_);
-      if (Has(kClamp) && p_.clamp_a) stencil(0, g2, 2, 0.5 * L0_);
-      if (Has(kClamp) && p_.clamp_b) stencil(N_ - 1, g2, 2, 0.5 * L0_);
+      for (int i = 1; i < N_; ++i) stencil(i - 1, g3, 3, CurvatureWeight(i));
+      if (Has(kClamp) && p_.clamp_a) stencil(0, g2, 2, 0.5 * rest_length(0));
+      if (Has(kClamp) && p_.clamp_b) stencil(N_ - 1, g2, 2, 0.5 * rest_length(N_ - 1));
       for (int u = 0; u < nu; ++u) {
         A.D(u).diagonal().array() += band0[3 * u];
         if (u >= 1) A.L1(u).diagonal().array() += band0[3 * u + 1];
@@ -333,8 +336,8 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         const double pen = wt.seabed - xk(2, i);
         if (pen <= 0) continue;
         BlockBand::Block d = A.D(i - 1);
-        d(2, 2) += h2 * seabed_k_ * share_(i) + h * seabed_c_ * share_(i);
-        const double N = std::max(0.0, share_(i) * (seabed_k_ * pen - seabed_c_ * vk(2, i)));
+        d(2, 2) += h2 * seabed_k_ * Share(i) + h * seabed_c_ * Share(i);
+        const double N = std::max(0.0, Share(i) * (seabed_k_ * pen - seabed_c_ * vk(2, i)));
         const double mu = std::max(wt.seabed_friction, wt.seabed_friction_axial);
         const double vh = std::hypot(vk(0, i), vk(1, i));
         const double eps = wt.seabed_friction_speed;
@@ -356,7 +359,7 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         const Vec3 xs = (1 - c.s) * xk.col(c.segment) + c.s * xk.col(c.segment + 1);
         if (!(c.normal.dot(xs - c.point - dt_ref * c.velocity) < 0.5 * p_.diameter)) continue;
         const Mat3 nn = c.normal * c.normal.transpose();
-        Mat3 B = (L0_ * (h2 * contact_k_ + h * contact_c_)) * nn;
+        Mat3 B = (rest_length(c.segment) * (h2 * contact_k_ + h * contact_c_)) * nn;
         if (p_.contact_friction > 0 && N > 0) {
           const Vec3 vrel = (1 - c.s) * vk.col(c.segment) + c.s * vk.col(c.segment + 1) -
                             c.velocity;
@@ -410,6 +413,11 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   const double L0sq = L0_ * L0_;
   auto linearisation_held = [&]() {
     for (int j = 0; j < N_; ++j) {
+      if (j == 0 && head_) {
+        const double r = WinchRest(next);
+        if (((xk.col(1) - xk.col(0)).squaredNorm() > r * r) != (w.l[0] > r)) return false;
+        continue;
+      }
       if (((xk.col(j + 1) - xk.col(j)).squaredNorm() > L0sq) != (w.l[j] > L0_)) return false;
     }
     // Friction saturates over the slip speed eps: where the slip of a contact changed the
@@ -438,9 +446,10 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
     double T_max = 0, missed = 0;
     for (int j = 0; j < N_; ++j) {
       T_max = std::max(T_max, w.T[j]);
-      if (!(w.l[j] > L0_)) continue;
+      const double L0 = j == 0 && head_ ? WinchRest(next) : L0_;
+      if (!(w.l[j] > L0)) continue;
       const Vec3 d = xk.col(j + 1) - xk.col(j);
-      missed = std::max(missed, p_.EA / L0_ * (d.norm() - t.col(j).dot(d)));
+      missed = std::max(missed, p_.EA / L0 * (d.norm() - t.col(j).dot(d)));
     }
     return missed <= std::max(kLinearisationTolerance * T_max, 1e-6 * p_.EA);
   };
@@ -464,8 +473,8 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   double dv_max = 0, W_max = 0, m_min = INFINITY, T_max = 0;
   for (int i = 1; i <= nu; ++i) {
     dv_max = std::max(dv_max, (vk.col(i) - v.col(i)).squaredNorm());
-    W_max = std::max(W_max, weight_.col(i).norm());
-    m_min = std::min(m_min, mass_(i));
+    W_max = std::max(W_max, Weight(i).norm());
+    m_min = std::min(m_min, Mass(i));
   }
   for (int j = 0; j < N_; ++j) T_max = std::max(T_max, w.T[j]);
   const double tolerance =
@@ -575,6 +584,19 @@ void Tether::Sdirk2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, dou
   }
 }
 
+void Tether::Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h, double* work,
+                  StepStatus* status) const {
+  if (p_.integrator == Integrator::kExplicit) {
+    ExplicitStep(x, v, now, next, h, work);
+  } else if (p_.integrator == Integrator::kRK4) {
+    Rk4Step(x, v, now, next, h, work);
+  } else if (p_.integrator == Integrator::kImplicit2) {
+    Sdirk2Step(x, v, now, next, h, work, status);
+  } else {
+    ImplicitStepAdaptive(x, v, now, next, h, 0, work, status);
+  }
+}
+
 StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends& to, double dt,
                            double* work) const {
   const int n = N_ + 1;
@@ -587,15 +609,7 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
   PlaceEnds(from, x, v);
   for (int k = 0; k < steps; ++k) {
     const Ends next = k + 1 == steps ? to : Interpolate(from, to, dt, double(k + 1) / steps);
-    if (p_.integrator == Integrator::kExplicit) {
-      ExplicitStep(x, v, now, next, h, work);
-    } else if (p_.integrator == Integrator::kRK4) {
-      Rk4Step(x, v, now, next, h, work);
-    } else if (p_.integrator == Integrator::kImplicit2) {
-      Sdirk2Step(x, v, now, next, h, work, &status);
-    } else {
-      ImplicitStepAdaptive(x, v, now, next, h, 0, work, &status);
-    }
+    Step(x, v, now, next, h, work, &status);
     // Work of the end forces over the step: the integrator's last force evaluation (explicit:
     // start of the step; implicit: the last Newton iterate; rk4: the last stage).
     const ConstNodes f(Work(work, N_).f, 3, n);
@@ -603,23 +617,32 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
     if (!p_.free_end) status.work_b += f.col(N_).dot(next.b.pos - now.b.pos);
     now = next;
   }
-  // Divergence: a non-finite value, or a strain no tether survives.
+  Check(ConstNodes(xp, 3, n), ConstNodes(vp, 3, n), from, to, &status);
+  return status;
+}
+
+// Divergence: a non-finite value, a strain no tether survives, or a kinetic energy no tether
+// holds.
+void Tether::Check(ConstNodes x, ConstNodes v, const Ends& from, const Ends& to,
+                   StepStatus* out) const {
+  const int n = N_ + 1;
+  StepStatus& status = *out;
   for (int i = 0; i < n; ++i) {
     if (!x.col(i).allFinite() || !v.col(i).allFinite()) {
       status.ok = false;
       status.node = i;
       status.reason = "non-finite position or velocity";
-      return status;
+      return;
     }
   }
   for (int j = 0; j < N_; ++j) {
-    const double strain = (x.col(j + 1) - x.col(j)).norm() / L0_ - 1;
+    const double strain = (x.col(j + 1) - x.col(j)).norm() / rest_length(j) - 1;
     if (strain > p_.max_strain) {
       status.ok = false;
       status.node = j + 1;
       status.reason = "strain " + std::to_string(strain) + " of segment " + std::to_string(j) +
                       " exceeds max_strain " + std::to_string(p_.max_strain);
-      return status;
+      return;
     }
   }
   // Energy blow-up: more kinetic energy than the tether could hold physically (an unstable
@@ -628,7 +651,7 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
   int fastest = -1;
   for (int i = 0; i < n; ++i) {
     if (!Dynamic(i)) continue;
-    const double e = 0.5 * (mass_(i) + added_(i)) * v.col(i).squaredNorm();
+    const double e = 0.5 * (Mass(i) + Added(i)) * v.col(i).squaredNorm();
     kinetic += e;
     if (e > node_max) node_max = e, fastest = i;
   }
@@ -640,7 +663,6 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
                     std::to_string(bound) + " J, " + std::to_string(kEnergyBlowUp) +
                     " times the most the tether can physically hold";
   }
-  return status;
 }
 
 // The most energy the tether can hold without diverging [J]: elastic energy at max_strain
@@ -653,12 +675,19 @@ double Tether::EnergyBound(const Ends& from, const Ends& to) const {
   double v = std::max(from.a.vel.norm(), to.a.vel.norm());
   if (!p_.free_end) v = std::max({v, from.b.vel.norm(), to.b.vel.norm()});
   if (Has(kCurrent)) v += env_.water.MaxCurrentSpeed();
-  const double M = mass_.sum() + added_.sum();
+  double M = 0;  // [kg] with added mass
+  if (head_) {
+    for (int i = 0; i <= N_; ++i) M += Mass(i) + Added(i);
+  } else {
+    const int n = N_ + 1;
+    M = Eigen::Map<const Eigen::VectorXd>(mass_, n).sum() +
+        Eigen::Map<const Eigen::VectorXd>(added_, n).sum();
+  }
   double E = 0.5 * p_.EA * p_.max_strain * p_.max_strain * L + 0.5 * M * v * v;
   if (Has(kBending)) E += 0.5 * p_.EI * (4 / (L0_ * L0_)) * L;
   if (Has(kCompression)) E += 0.5 * p_.EAc * L;
   double W = 0;  // [N] net weight, without sign
-  for (int i = 0; i <= N_; ++i) W += weight_.col(i).norm();
+  for (int i = 0; i <= N_; ++i) W += Weight(i).norm();
   return E + W * L;
 }
 

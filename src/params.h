@@ -127,6 +127,10 @@ struct TetherParams {
   double contact_damping = -1;     // [N s/m^2] per length; < 0: critical for the tether's mass
   double contact_friction = 0;     // [-] Coulomb coefficient (isotropic)
   double contact_friction_speed = 0.01;  // [m/s] slip speed over which friction saturates (tanh)
+  // A winch at end A (declared by winch:NAME; docs/winch.md): segments is then the allocation
+  // for the longest deployment and length = segments x L0; the explicit stability limit is
+  // taken at the shortest viable winch segment, L0/2.
+  bool winch = false;
 };
 
 // Everything a Tether needs from its surroundings.

@@ -77,22 +77,31 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
   const double rho = env.wet ? env.water.density : 0;
 
   // Lumped masses: half of each adjacent segment.
-  c.share_ = Eigen::VectorXd::Constant(n, c.L0_);
-  c.share_(0) = c.share_(c.N_) = c.L0_ / 2;
-  c.mass_ = params.mass_per_length * c.share_;
-  c.added_ = c.Has(kAddedMass) ? Eigen::VectorXd(params.Can * rho * c.area_ * c.share_)
-                               : Eigen::VectorXd::Zero(n);
-  c.inv_mass_ = c.mass_.cwiseInverse();
+  auto arrays = std::make_shared<NodeArrays>();
+  NodeArrays& a = *arrays;
+  a.share = Eigen::VectorXd::Constant(n, c.L0_);
+  a.share(0) = a.share(c.N_) = c.L0_ / 2;
+  a.mass = params.mass_per_length * a.share;
+  a.added = c.Has(kAddedMass) ? Eigen::VectorXd(params.Can * rho * c.area_ * a.share)
+                              : Eigen::VectorXd::Zero(n);
+  a.inv_mass = a.mass.cwiseInverse();
   c.damping_per_L0_ = params.damping / c.L0_;
-  c.inv_mass_normal_ = (c.mass_ + c.added_).cwiseInverse();
+  a.inv_mass_normal = (a.mass + a.added).cwiseInverse();
   // Net weight: dry weight minus buoyancy of the displaced volume.
-  c.weight_ = Eigen::Matrix3Xd::Zero(3, n);
+  a.weight = Eigen::Matrix3Xd::Zero(3, n);
   for (int i = 0; i < n; ++i) {
     double m = 0;
-    if (c.Has(kWeight)) m += c.mass_(i);
-    if (c.Has(kBuoyancy)) m -= rho * c.area_ * c.share_(i);
-    c.weight_.col(i) = m * env.gravity;
+    if (c.Has(kWeight)) m += a.mass(i);
+    if (c.Has(kBuoyancy)) m -= rho * c.area_ * a.share(i);
+    a.weight.col(i) = m * env.gravity;
   }
+  c.mass_ = a.mass.data();
+  c.added_ = a.added.data();
+  c.inv_mass_ = a.inv_mass.data();
+  c.inv_mass_normal_ = a.inv_mass_normal.data();
+  c.share_ = a.share.data();
+  c.weight_ = a.weight.data();
+  c.arrays_ = std::move(arrays);
   // Morison drag per unit length: 1/2 rho Cdn d |vn| vn and 1/2 rho Cdt pi d |vt| vt.
   c.kn_ = 0.5 * rho * params.Cdn * params.diameter;
   c.kt_ = 0.5 * rho * params.Cdt * kPi * params.diameter;
@@ -123,13 +132,19 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
   // On the reference scenes the measured limit is 0.98-1.06 times this (tests/stable_step_test.cc;
   // a step beyond it does not always blow up: the slack clamp T >= 0 bounds the unstable
   // highest mode, and the run goes on with tensions tens of percent wrong).
+  // With a winch the shortest segment is the winch segment at its shortest, L0/2: the limit
+  // is that of a tether of segments L0/2 throughout (node masses and lengths halved with them).
+  const double L0_save = c.L0_;
+  const double winch_scale = params.winch ? 0.5 : 1.0;
+  c.L0_ *= winch_scale;
   c.explicit_limit_ = INFINITY;  // no dynamic node (one segment between two sites)
   {
     const double ea = c.Has(kCompression) ? std::max(params.EA, params.EAc) : params.EA;
     for (int i = 0; i < n; ++i) {
       if (!c.Dynamic(i)) continue;
       const int segments_at_node = (i > 0) + (i < c.N_);
-      const double m = c.mass_(i), mn = c.mass_(i) + c.added_(i);  // [kg]
+      const double m = winch_scale * c.mass_[i];                     // [kg]
+      const double mn = winch_scale * (c.mass_[i] + c.added_[i]);    // [kg]
       double w2 = 2 * segments_at_node * (ea / c.L0_) / m;           // [1/s^2]
       double rate = 0;                                               // [1/s] damping / mass
       c.terms_.w_axial = std::max(c.terms_.w_axial, std::sqrt(w2));
@@ -140,11 +155,11 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
         c.terms_.w_bending = std::max(c.terms_.w_bending, std::sqrt(wb2));
       }
       if (c.Has(kSeabed)) {
-        w2 += c.seabed_k_ * c.share_(i) / m;
-        c.terms_.w_seabed = std::max(c.terms_.w_seabed, std::sqrt(c.seabed_k_ * c.share_(i) / m));
-        rate += c.seabed_c_ * c.share_(i) / m;
+        w2 += c.seabed_k_ * winch_scale * c.share_[i] / m;
+        c.terms_.w_seabed = std::max(c.terms_.w_seabed, std::sqrt(c.seabed_k_ * winch_scale * c.share_[i] / m));
+        rate += c.seabed_c_ * winch_scale * c.share_[i] / m;
         const double mu = std::max(env.water.seabed_friction, env.water.seabed_friction_axial);
-        rate += mu * c.weight_.col(i).norm() / (env.water.seabed_friction_speed * m);
+        rate += mu * winch_scale * c.Weight(i).norm() / (env.water.seabed_friction_speed * m);
       }
       // A contact point at a node puts its whole stiffness k L0 on that node.
       if (c.Has(kContact)) {
@@ -161,6 +176,7 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
       c.explicit_limit_ = std::min(c.explicit_limit_, h);
     }
   }
+  c.L0_ = L0_save;
   c.explicit_dt_ = kExplicitSafety * c.explicit_limit_;
   // The 3-node window for the end reactions: rest length L0 per segment, so its end nodes
   // carry the same lumped length, mass, weight and curvature weights as the tether's.
@@ -168,6 +184,7 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
     TetherParams wp = params;
     wp.segments = 2;
     wp.length = 2 * c.L0_;
+    wp.winch = false;
     std::optional<Tether> window = Create(wp, env, error);
     if (!window) return std::nullopt;
     c.window_ = std::make_shared<const Tether>(std::move(*window));
@@ -198,7 +215,7 @@ void Tether::InitialShape(const Ends& ends, double* xp, double* vp) const {
   const Vec3 A = ends.a.pos;
   const double L = p_.length;
   // "Down" is the way the net weight pulls; without weight, gravity's way; without gravity, -z.
-  Vec3 down = weight_.col(0).norm() > 0 ? Vec3(weight_.col(0).normalized())
+  Vec3 down = Weight(0).norm() > 0 ? Vec3(Weight(0).normalized())
               : env_.gravity.norm() > 0 ? Vec3(env_.gravity.normalized())
                                         : Vec3(0, 0, -1);
   if (p_.free_end) {
@@ -343,7 +360,7 @@ void Tether::RestOnLevel(const Ends& ends, double zb, Nodes x) const {
   bool below = false;
   for (int k = 0; k <= N_ && !below; ++k) below = x(2, k) < zb;
   if (!below) return;
-  const Vec3 g = weight_.col(0).norm() > 0 ? Vec3(weight_.col(0)) : env_.gravity;
+  const Vec3 g = Weight(0).norm() > 0 ? Weight(0) : env_.gravity;
   const bool vertical = g.norm() > 0 && -g.z() >= (1 - 1e-9) * g.norm();
   const Vec3& A = ends.a.pos;
   const Vec3 ez = Vec3::UnitZ();

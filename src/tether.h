@@ -46,6 +46,20 @@ struct Ends {
   // (contact.h), shared by every instant of one Advance; null: no contact this step.
   double time = 0;
   const ContactSet* contacts = nullptr;
+  // With a winch (a view from Tether::Deployed): the rest length of the winch segment (segment
+  // 0, from the drum at end A) at this instant [m]; 0 without a winch.
+  double rest = 0;
+};
+
+// The deployment of a tether with a winch at end A (docs/winch.md). Nodes 0..first-1 are on
+// the drum (at end A's site, inert); node `first` is the drum exit (the attached end A); the
+// winch segment from it to node first+1 has rest length `rest` (between 0.5 and 1.5 L0 after
+// every step), every other deployed segment L0. Deployed unstretched length:
+// (segments() - first - 1) L0 + rest.
+struct Payout {
+  int first = 0;     // [-] index of the drum-exit node
+  double rest = 0;   // [m] rest length of the winch segment
+  double speed = 0;  // [m/s] payout speed d rest/dt over this Advance (> 0 pays out)
 };
 
 // What the tether does to the sites it is attached to.
@@ -114,6 +128,22 @@ class Tether {
   // time between the two, so positions and velocities at both instants are matched).
   StepStatus Advance(double* x, double* v, const Ends& from, const Ends& to, double dt,
                      double* work) const;
+  // The same for a tether with a winch at end A (params().winch): the winch segment's rest
+  // length grows by payout->speed dt over the advance (linearly), and whenever it leaves
+  // [0.5, 1.5] L0 a node is inserted at or removed from the drum (Regrid); *payout is updated.
+  // x and v hold the whole allocation, segments() + 1 nodes.
+  StepStatus Advance(double* x, double* v, const Ends& from, const Ends& to, double dt,
+                     double* work, Payout* payout) const;
+
+  // The deployed part of a tether with a winch as a tether of its own: segments() - first
+  // segments, the first of rest length `rest` [m], the nodes' lumped masses, weights and
+  // curvature weights following it, state at x + 3 first. No allocation (it shares the node
+  // arrays), so it can be made at every step.
+  Tether Deployed(int first, double rest, double speed) const;
+  // Inserts (rest > 1.5 L0) or removes (rest < 0.5 L0) one node at the drum, conserving the
+  // deployed mass mu L and the momentum (docs/winch.md); ends `e` (the drum at end A).
+  // Returns +1 (inserted), -1 (removed) or 0.
+  int Regrid(double* x, double* v, const Ends& e, Payout* payout) const;
 
   // Forces on every node f (3 x n) [N], and segment tensions T (N) [N], >= 0 (a compression
   // reads 0), when T is not null, from the state as it is (ends as stored in x, v).
@@ -152,8 +182,12 @@ class Tether {
   const StabilityTerms& stability_terms() const { return terms_; }
 
   // Node masses [kg] (dry, lumped) and net weight force [N] per node.
-  double node_mass(int i) const { return mass_[i]; }
-  Vec3 node_weight(int i) const { return weight_.col(i); }
+  double node_mass(int i) const { return Mass(i); }
+  Vec3 node_weight(int i) const { return Weight(i); }
+  // Rest length of segment j [m] (L0, or the winch segment's in a Deployed view; in a view the
+  // winch segment's rest length changes within a step, see Ends::rest).
+  double rest_length(int j) const { return j == 0 && head_ ? rest_ : L0_; }
+  double mass_per_length() const { return p_.mass_per_length; }
 
  private:
   Tether() = default;
@@ -173,7 +207,7 @@ class Tether {
   void SegmentGeometry(ConstNodes x, Nodes t, double* l) const;
   double AxialForce(double eps, const Vec3& t, const Vec3& dv, double engage_h) const;
   void AddAxial(ConstNodes x, ConstNodes v, ConstNodes t, const double* l, double* T,
-                Nodes f, const Start* start) const;
+                Nodes f, const Start* start, double rest0) const;
   void BendingMoments(ConstNodes t, const Ends& ends, Nodes M) const;
   void AddBending(ConstNodes t, const double* l, ConstNodes M, Nodes f) const;
   void NodeTangents(ConstNodes x, ConstNodes t, Nodes q) const;
@@ -220,13 +254,53 @@ class Tether {
   double explicit_limit_ = 0;   // [s]
   double explicit_dt_ = 0;      // [s]
   StabilityTerms terms_;
-  Eigen::VectorXd mass_;        // [kg] (n) dry lumped mass
-  Eigen::VectorXd added_;       // [kg] (n) normal added mass Can rho A l_i
   double damping_per_L0_ = 0;  // [N s/m] internal damping / rest segment length
-  Eigen::VectorXd inv_mass_;          // [1/kg] (n) 1/m_i (multiplying is cheaper than dividing)
-  Eigen::VectorXd inv_mass_normal_;   // [1/kg] (n) 1/(m_i + ma_i)
-  Eigen::VectorXd share_;       // [m] (n) rest length lumped at each node
-  Eigen::Matrix3Xd weight_;     // [N] (3 x n) weight minus buoyancy per node
+  // Per-node arrays, owned by the tether and shared (not copied) by its Deployed views, which
+  // point at their first node.
+  struct NodeArrays {
+    Eigen::VectorXd mass;             // [kg] (n) dry lumped mass
+    Eigen::VectorXd added;            // [kg] (n) normal added mass Can rho A l_i
+    Eigen::VectorXd inv_mass;         // [1/kg] (n) 1/m_i (multiplying is cheaper than dividing)
+    Eigen::VectorXd inv_mass_normal;  // [1/kg] (n) 1/(m_i + ma_i)
+    Eigen::VectorXd share;            // [m] (n) rest length lumped at each node
+    Eigen::Matrix3Xd weight;          // [N] (3 x n) weight minus buoyancy per node
+  };
+  std::shared_ptr<const NodeArrays> arrays_;
+  const double* mass_ = nullptr;  // arrays_ from this tether's node 0 on
+  const double* added_ = nullptr;
+  const double* inv_mass_ = nullptr;
+  const double* inv_mass_normal_ = nullptr;
+  const double* share_ = nullptr;
+  const double* weight_ = nullptr;  // 3 x n
+  // A Deployed view: nodes 0 (drum exit) and 1 have the lumped values of the winch segment's
+  // rest length rest_ instead of the arrays' (head_ = 2; 0 in the tether itself).
+  int head_ = 0;
+  double rest_ = 0;   // [m]
+  double speed_ = 0;  // [m/s] payout speed, d rest_/dt
+  double head_mass_[2] = {0, 0}, head_added_[2] = {0, 0}, head_inv_mass_[2] = {0, 0},
+         head_inv_mass_normal_[2] = {0, 0}, head_share_[2] = {0, 0};
+  Vec3 head_weight_[2] = {Vec3::Zero(), Vec3::Zero()};
+  double Mass(int i) const { return i < head_ ? head_mass_[i] : mass_[i]; }
+  double Added(int i) const { return i < head_ ? head_added_[i] : added_[i]; }
+  double InvMass(int i) const { return i < head_ ? head_inv_mass_[i] : inv_mass_[i]; }
+  double InvMassNormal(int i) const {
+    return i < head_ ? head_inv_mass_normal_[i] : inv_mass_normal_[i];
+  }
+  double Share(int i) const { return i < head_ ? head_share_[i] : share_[i]; }
+  Vec3 Weight(int i) const { return i < head_ ? head_weight_[i] : Vec3(weight_ + 3 * i); }
+  ConstNodes WeightMatrix() const { return ConstNodes(weight_, 3, N_ + 1); }
+  // The winch segment's rest length at the instant of `e` [m] (a Deployed view).
+  double WinchRest(const Ends& e) const { return e.rest > 0 ? e.rest : rest_; }
+  // Galerkin curvature weight at interior node i: the mean of its two segments' rest lengths.
+  double CurvatureWeight(int i) const {
+    return i == 1 && head_ ? 0.5 * (rest_ + L0_) : L0_;
+  }
+  // One tether step of the configured integrator (the body of Advance's loop).
+  void Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h, double* work,
+            StepStatus* status) const;
+  // The divergence checks at the end of an Advance.
+  void Check(ConstNodes x, ConstNodes v, const Ends& from, const Ends& to,
+             StepStatus* status) const;
   // The same tether cut to its first two segments (N >= 3): the end reactions depend only on
   // the end node's two neighbours, so Reactions evaluates this 3-node window at each end
   // instead of the whole tether (same operations in the same order, so the same bits).

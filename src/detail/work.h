@@ -3,6 +3,7 @@
 #pragma once
 
 #include "block_band.h"
+#include "tether.h"
 
 namespace mjtether {
 namespace detail {
@@ -72,6 +73,12 @@ struct Work {
     vb = dv + 3 * n;
   }
 };
+
+}  // namespace detail
+// The ends at fraction s of a step of dt [s] between `from` and `to` (cubic Hermite; the
+// winch segment's rest length linearly).
+Ends Interpolate(const Ends& from, const Ends& to, double dt, double s);
+namespace detail {
 
 // The window's inputs (x, v 3 x 3 each), outputs (f 3 x 3, T 2) and its own scratch follow
 // the tether's scratch.

@@ -1,0 +1,159 @@
+// Variable deployed length for a tether with a winch at end A (docs/winch.md).
+//
+// Scheme: the state is allocated for the longest deployment (WHOI Cable's pre-allocated nodes);
+// every deployed segment has the nominal rest length L0 except the winch segment at the drum,
+// whose rest length r follows the payout continuously (r' = payout speed) between 0.5 and
+// 1.5 L0; past 1.5 L0 a node is inserted at the drum, below 0.5 L0 one is removed (OrcaFlex's
+// variable-segment winch, with its bounds). The lumped masses follow r at every step, so the
+// deployed mass is mu L at every step.
+#include <algorithm>
+#include <cmath>
+
+#include "detail/work.h"
+#include "tether.h"
+
+namespace mjtether {
+using namespace detail;
+
+Tether Tether::Deployed(int first, double rest, double speed) const {
+  Tether d = *this;  // shares the node arrays and the window: no allocation
+  d.N_ = N_ - first;
+  d.mass_ += first;
+  d.added_ += first;
+  d.inv_mass_ += first;
+  d.inv_mass_normal_ += first;
+  d.share_ += first;
+  d.weight_ += 3 * first;
+  d.head_ = 2;
+  d.rest_ = rest;
+  d.speed_ = speed;
+  d.p_.segments = d.N_;
+  d.p_.length = (d.N_ - 1) * L0_ + rest;
+  // Nodes 0 and 1 lump half the winch segment each, node 1 also half the next segment (if any).
+  const double rho = env_.wet ? env_.water.density : 0;
+  const double share[2] = {0.5 * rest, 0.5 * rest + (d.N_ >= 2 ? 0.5 * L0_ : 0)};
+  for (int i = 0; i < 2; ++i) {
+    const double m = p_.mass_per_length * share[i];
+    const double ma = Has(kAddedMass) ? p_.Can * rho * area_ * share[i] : 0;
+    d.head_share_[i] = share[i];
+    d.head_mass_[i] = m;
+    d.head_added_[i] = ma;
+    d.head_inv_mass_[i] = 1 / m;
+    d.head_inv_mass_normal_[i] = 1 / (m + ma);
+    double w = 0;
+    if (Has(kWeight)) w += m;
+    if (Has(kBuoyancy)) w -= rho * area_ * share[i];
+    d.head_weight_[i] = w * env_.gravity;
+  }
+  return d;
+}
+
+// Insertion (r > 1.5 L0): the new node goes on the winch segment at L0 from node first+1, so
+// that the segment it closes has the rest length L0 and the winch segment keeps r - L0, both
+// at the strain the winch segment had (no tension jump). Its position and velocity are the
+// linear interpolation, at that point, of the segment's ends, with the drum end moving as the
+// material that leaves the drum, u_e = v_drum + (l/r) r' t (the payout, stretched, along the
+// segment's tangent t): the strain rate of both new segments is then that of the winch
+// segment, and the momentum of the deployed tether, sum m_i v_i with the drum-exit node's
+// lumped mass moving at u_e, is unchanged exactly: with m_exit = mu r/2 and m_1 = mu (r+L0)/2
+// before, mu (r-L0)/2, mu r/2 and mu L0 (mu L0/2 at a last node) after, the interpolation
+// weights are what makes the sums equal (docs/winch.md works it out).
+//
+// Removal (r < 0.5 L0): node first+1 goes, the winch segment reaches node first+2 with rest
+// r + L0, and node first+2 takes the removed node's momentum: its velocity is set so that the
+// momentum (same definition) is unchanged, v2' = (m_exit u_e + m1 v1 + m2 v2 - m_exit' u_e')
+// / m2'. (Removing a node is inelastic: the relative motion of the two merged nodes is lost.)
+int Tether::Regrid(double* xp, double* vp, const Ends& e, Payout* p) const {
+  const int n = N_ + 1;
+  Nodes x(xp, 3, n), v(vp, 3, n);
+  const int f = p->first;
+  const double r = p->rest, mu = p_.mass_per_length;
+  const Vec3 d = e.a.pos, vd = e.a.vel;
+  // Velocity of the material leaving the drum along the segment from the drum to node k.
+  auto exit_velocity = [&](int k, double rest) -> Vec3 {
+    const Vec3 chord = x.col(k) - d;
+    const double l = chord.norm();
+    if (!(l > kMinLengthRatio * L0_)) return vd;
+    return vd + (p->speed / rest) * chord;  // (l/r) r' t
+  };
+  if (r > 1.5 * L0_ && f > 0) {
+    const Vec3 ue = exit_velocity(f + 1, r);
+    const double a = L0_ / r;
+    const Vec3 x1 = x.col(f + 1), v1 = v.col(f + 1);
+    // Position: along the chord, where the new node is in axial equilibrium under its own net
+    // weight W (share r/2): EA (l_u/r_u - 1) - EA (l_l/L0 - 1) = W.t with l_u + l_l = l. The
+    // lumped weight it takes over was carried by the drum directly; at the plain fraction
+    // L0/r it would sag for a step (a dip of W in the drum's tension, 0.8% in the test).
+    // For a straight hanging line this is the exact static split (docs/winch.md); slack or
+    // without weight, the plain fraction.
+    double frac = a;  // of the chord, from node first+1 towards the drum
+    const Vec3 chord = d - x1;
+    const double l = chord.norm();
+    if (Has(kAxial) && l > r && N_ >= 2) {
+      const Vec3 t = -chord / l;  // from the drum towards node first+1
+      const double g = Vec3(weight_ + 3).dot(t) * (0.5 * r / L0_);  // [N] W.t, share r/2
+      const double ru = r - L0_;
+      const double lu = (g / p_.EA + l / L0_) / (1 / ru + 1 / L0_);
+      if (lu > ru && l - lu > L0_) frac = (l - lu) / l;
+    }
+    x.col(f) = x1 + frac * chord;
+    v.col(f) = v1 + a * (ue - v1);
+    x.col(f - 1) = d;
+    v.col(f - 1) = vd;
+    p->first = f - 1;
+    p->rest = r - L0_;
+    return 1;
+  }
+  if (r < 0.5 * L0_ && f + 2 <= N_) {
+    const Vec3 ue = exit_velocity(f + 1, r);
+    const Vec3 ue2 = exit_velocity(f + 2, r + L0_);
+    const double m_exit = 0.5 * mu * r, m1 = 0.5 * mu * (r + L0_);
+    const double m2 = mu * share_[f + 2];  // the dry lumped mass of node f+2 before
+    const double m_exit2 = 0.5 * mu * (r + L0_), m2b = m2 + 0.5 * mu * r;
+    if (f + 2 < N_ || p_.free_end) {
+      v.col(f + 2) =
+          (m_exit * ue + m1 * v.col(f + 1) + m2 * v.col(f + 2) - m_exit2 * ue2) / m2b;
+    }
+    x.col(f + 1) = d;
+    v.col(f + 1) = vd;
+    p->first = f + 1;
+    p->rest = r + L0_;
+    return -1;
+  }
+  return 0;
+}
+
+StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends& to, double dt,
+                           double* work, Payout* p) const {
+  if (!p) return Advance(xp, vp, from, to, dt, work);
+  StepStatus status;
+  const int steps = SubstepsFor(dt);
+  if (steps == 0) return status;
+  const double h = dt / steps;
+  Ends now = from;
+  now.rest = p->rest;
+  for (int k = 0; k < steps; ++k) {
+    Ends next = k + 1 == steps ? to : Interpolate(from, to, dt, double(k + 1) / steps);
+    next.rest = now.rest + p->speed * h;
+    const Tether view = Deployed(p->first, now.rest, p->speed);
+    const int na = view.nodes();
+    Nodes x(xp + 3 * p->first, 3, na), v(vp + 3 * p->first, 3, na);
+    view.PlaceEnds(now, x, v);
+    view.Step(x, v, now, next, h, work, &status);
+    p->rest = next.rest;
+    // At most one node per step: a payout of more than L0/2 per tether step is refused at load.
+    Regrid(xp, vp, next, p);
+    now = next;
+    now.rest = p->rest;
+  }
+  const Tether view = Deployed(p->first, p->rest, p->speed);
+  const int na = view.nodes();
+  Ends last = to;
+  last.rest = p->rest;
+  view.Check(ConstNodes(xp + 3 * p->first, 3, na), ConstNodes(vp + 3 * p->first, 3, na), from,
+             last, &status);
+  if (!status.ok) status.node += p->first;
+  return status;
+}
+
+}  // namespace mjtether
