@@ -248,7 +248,7 @@ void Tether::AddSeabedSurface(ConstNodes x, ConstNodes v, ConstNodes q, Nodes f,
       w.surface.Under(start->x(0, i), start->x(1, i), &zs0, &n0);
       if (start->x(2, i) >= zs0) sink = std::min(sink, pen / start->h);
     }
-    const double Nk = std::max(0.0, share_(i) * (seabed_k_ * pen + seabed_c_ * sink));
+    const double Nk = std::max(0.0, Share(i) * (seabed_k_ * pen + seabed_c_ * sink));
     f.col(i) += Nk * n;
     if (w.seabed_friction == 0 && w.seabed_friction_axial == 0) continue;
     Vec3 qh = q.col(i) - q.col(i).dot(n) * n;

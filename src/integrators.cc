@@ -321,9 +321,9 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         if (pen <= 0) continue;
         BlockBand::Block d = A.D(i - 1);
         const Mat3 nn = n * n.transpose();
-        d += (h2 * seabed_k_ * share_(i) + h * seabed_c_ * share_(i)) * nn;
+        d += (h2 * seabed_k_ * Share(i) + h * seabed_c_ * Share(i)) * nn;
         const double N =
-            std::max(0.0, share_(i) * (seabed_k_ * pen - seabed_c_ * vk.col(i).dot(n)));
+            std::max(0.0, Share(i) * (seabed_k_ * pen - seabed_c_ * vk.col(i).dot(n)));
         const double mu = std::max(wt.seabed_friction, wt.seabed_friction_axial);
         const double vh = (vk.col(i) - vk.col(i).dot(n) * n).norm();
         const double eps = wt.seabed_friction_speed;
