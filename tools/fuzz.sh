@@ -15,7 +15,10 @@ clang++-14 -std=c++17 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-r
 # Seeds: the data="..." of every <text> in the models, and edge cases.
 i=0
 for f in models/*.xml; do
-  grep -o 'data="[^"]*"' "$f" | sed -e 's/^data="//' -e 's/"$//' | while IFS= read -r seed; do
+  # Lines joined first: most declarations span lines. A model without any (grep finds
+  # nothing, exit 1) must not stop the script under pipefail.
+  { tr '\n' ' ' < "$f" | grep -o 'data="[^"]*"' || true; } | sed -e 's/^data="//' -e 's/"$//' |
+    while IFS= read -r seed; do
     printf '%s' "$seed" > "$out/corpus/model_$(basename "$f" .xml)_$i"; i=$((i + 1))
   done
 done
