@@ -9,23 +9,6 @@
 namespace mjtether {
 namespace {
 
-// Parses "a,b,c,d" into 4 decimal numbers (surrounding blanks allowed); false otherwise.
-bool ParseRow(const std::string& line, double out[4]) {
-  std::istringstream s(line);
-  std::string item;
-  int n = 0;
-  while (std::getline(s, item, ',')) {
-    if (n == 4) return false;
-    const size_t first = item.find_first_not_of(" \t\r"), last = item.find_last_not_of(" \t\r");
-    if (first == std::string::npos) return false;
-    if (ParseDecimal(item.substr(first, last - first + 1), &out[n]) != NumberStatus::kOk) {
-      return false;
-    }
-    ++n;
-  }
-  return n == 4;
-}
-
 // Ranges: heights as the seabed's [m], current components as the uniform current's [m/s].
 constexpr double kMinZ = -1.1e4, kMaxZ = 1e4, kMaxU = 1e3;
 
@@ -46,7 +29,7 @@ std::optional<CurrentProfile> ReadCurrentProfile(const std::string& path, std::s
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
     const std::string where = path + " line " + std::to_string(row) + ": ";
     double v[4];
-    if (!ParseRow(line, v)) {
+    if (!ParseCsvRow(line, 4, v)) {
       if (row == 1) continue;  // a header
       return fail(where + "expected 4 finite decimal numbers z,ux,uy,uz");
     }

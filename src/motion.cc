@@ -13,23 +13,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// Parses "a,b,c,d" into 4 decimal numbers (surrounding blanks allowed); false otherwise.
-bool ParseRow(const std::string& line, double out[4]) {
-  std::istringstream s(line);
-  std::string item;
-  int n = 0;
-  while (std::getline(s, item, ',')) {
-    if (n == 4) return false;
-    const size_t first = item.find_first_not_of(" \t\r"), last = item.find_last_not_of(" \t\r");
-    if (first == std::string::npos) return false;
-    if (ParseDecimal(item.substr(first, last - first + 1), &out[n]) != NumberStatus::kOk) {
-      return false;
-    }
-    ++n;
-  }
-  return n == 4;
-}
-
 // Ranges of a table row: times [s] and offsets [m] (as a harmonic motion's amplitude).
 constexpr double kMaxTableTime = 1e7;
 constexpr double kMaxTableOffset = 1e4;
@@ -53,7 +36,7 @@ std::optional<Motion> Motion::Create(const MotionParams& params, const std::stri
       ++row;
       if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
       double v[4];
-      if (!ParseRow(line, v)) {
+      if (!ParseCsvRow(line, 4, v)) {
         if (row == 1) continue;  // a header
         return fail("key 'csv': " + csv_path + " line " + std::to_string(row) +
                     ": expected 4 decimal numbers time,x,y,z");

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <sstream>
 
 namespace mjtether {
 namespace {
@@ -224,6 +225,22 @@ std::vector<std::string> SplitCsvLine(const std::string& line) {
   }
   out.push_back(field);
   return out;
+}
+
+bool ParseCsvRow(const std::string& line, int count, double* out) {
+  std::istringstream s(line);
+  std::string item;
+  int n = 0;
+  while (std::getline(s, item, ',')) {
+    if (n == count) return false;
+    const size_t first = item.find_first_not_of(" \t\r"), last = item.find_last_not_of(" \t\r");
+    if (first == std::string::npos) return false;
+    if (ParseDecimal(item.substr(first, last - first + 1), &out[n]) != NumberStatus::kOk) {
+      return false;
+    }
+    ++n;
+  }
+  return n == count;
 }
 
 }  // namespace mjtether

@@ -22,6 +22,9 @@ enum class NumberStatus {
   kOverflow,   // beyond the largest double (1.8e308)
 };
 NumberStatus ParseDecimal(const std::string& text, double* value);
+// Parses a CSV row of exactly `count` decimal numbers ("a,b,c", blanks around each allowed)
+// into out; false otherwise (the motion and current-profile files).
+bool ParseCsvRow(const std::string& line, int count, double* out);
 
 // Why a number was refused, as a phrase after the quoted text: "is not a number", "is not a
 // finite number", "is hexadecimal; write it in decimal", "is out of range: ...".
