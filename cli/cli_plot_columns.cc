@@ -156,7 +156,7 @@ int PlotColumns(const ColumnPlot& p) {
   g << "set terminal pngcairo size " << p.width << "," << p.height << " font 'sans,11'\n"
     << "set output " << Quote(p.out) << "\n"
     << "set title " << Quote(p.input) << " noenhanced\n"
-    << "set grid\nset key top left noenhanced\n"
+    << "set grid\nset key outside right top vertical noenhanced\n"  // legend off the data
     << "set xlabel " << Quote(p.x) << " noenhanced\n"
     << "set ylabel " << Quote(p.y) << " noenhanced\n"
     << "plot ";

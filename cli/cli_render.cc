@@ -4,11 +4,16 @@
 //   mjtether render MODEL.xml --duration S --video out.mp4 [--fps 30] [--size 1280x720]
 //       [--camera follow|top|track:BODY|NAME] [--png-every S DIR] [--samples N]
 //       [--tension-max N|auto] [--distance M|auto] [--speedup X] [--vehicle BODY] [--no-hud]
+//       [--render-threads N|auto]
 //
 // Frame k shows the state at step round(k / (fps h)), h the model's timestep: frames are
 // scheduled by index, so they never drift from t = k/fps by more than h/2 however long the
 // video. The video has floor(duration * fps) + 1 frames, t = 0 to the last instant of the grid
 // k/fps <= duration (so the end of the run is rendered when it falls on the grid).
+// The simulation thread computes each frame's camera in order (Renderer::NextPose: the follow
+// camera is a filter over frames); with several render threads the frames are rendered in
+// parallel while the simulation goes on and written to ffmpeg in order (render/pipeline.h);
+// --render-threads 1 renders each in turn.
 #include <unistd.h>
 
 #include <algorithm>
@@ -30,6 +35,7 @@
 #include "cli_pipe.h"
 #include "step_check.h"
 #include "mjtether.h"
+#include "pipeline.h"
 #include "render.h"
 
 namespace {
@@ -48,6 +54,7 @@ struct RenderCliOptions {
   double speedup = 1;
   std::string vehicle;
   bool no_hud = false;
+  int render_threads = 0;  // 0: automatic, 1: serial
 };
 
 // "auto" for --tension-max and --distance: stored as 0, the value that means automatic.
@@ -59,6 +66,8 @@ CLI::Validator Auto() {
       },
       "auto", "");
 }
+
+constexpr int kStill = 1;  // a frame's flag: write it as a PNG still too
 
 bool ParseSize(const std::string& s, int* w, int* h) {
   char x = 0, extra = 0;
@@ -189,20 +198,67 @@ int Render(const RenderCliOptions& opt) {
     ropt.tension_max = mjtether::render::NiceCeil(*tmax);
   }
 
-  std::unique_ptr<mjtether::render::Renderer> renderer =
-      mjtether::render::Renderer::Create(m, ropt, &error);
-  if (!renderer) {
+  const int W = ropt.width, H = ropt.height;
+
+  ChildPipe ffmpeg;  // started once the renderers exist
+  DataPtr data = MakeData(m);
+  mjData* d = data.get();
+  Observer observer(m);
+  const bool progress = isatty(2);
+  std::vector<double> frame_ms;
+  long long step = 0, next_png = 0, npng = 0;
+  int status = 0;       // set by this thread
+  int sink_status = 0;  // set by the sink, read after Flush
+  std::string interrupted;  // why the run stopped early, printed once the frames are written
+  auto start = std::chrono::steady_clock::now();  // of the frame loop
+
+  // Each rendered frame, in order: to ffmpeg, and to a PNG if it is a still. Runs in the
+  // pipeline's writer thread (or in this one with --render-threads 1).
+  auto sink = [&](const mjtether::render::Frame& f) {
+    frame_ms.push_back(f.render_ms);
+    if (!opt.video.empty() && !ffmpeg.Write(f.rgb, static_cast<size_t>(3) * W * H)) {
+      sink_status = kExitTool;  // ffmpeg stopped reading: its exit status is reported below
+      return false;
+    }
+    if (f.flags & kStill) {
+      char name[64];
+      std::snprintf(name, sizeof(name), "t_%09.3f.png", f.tag * frame_dt);
+      const std::string path = (fs::path(png_dir) / name).string();
+      ToolOutput png;
+      std::string png_error;
+      if (!png.Open(path, "--png-every", &guard, &png_error)) {
+        std::cerr << (progress ? "\n" : "") << "mjtether: " << png_error << "\n";
+        sink_status = kExitBadInput;
+        return false;
+      }
+      if (!mjtether::render::WritePng(png.path(), f.rgb, W, H, &png_error) ||
+          !png.Commit(&png_error)) {
+        std::cerr << (progress ? "\n" : "") << "mjtether: output error: " << png_error << "\n";
+        sink_status = kExitOutput;
+        return false;
+      }
+      ++npng;
+    }
+    if (progress) {
+      Progress(f.tag + 1, nframes, f.time,
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    }
+    return true;
+  };
+  mjtether::render::PipelineOptions popt;
+  popt.threads = opt.render_threads;
+  std::unique_ptr<mjtether::render::FramePipeline> pipeline =
+      mjtether::render::FramePipeline::Create(m, ropt, popt, sink, &error);
+  if (!pipeline) {
     std::cerr << "mjtether: " << opt.model << ": " << error << "\n";
     return error.rfind("OSMesa", 0) == 0 || error.rfind("MuJoCo", 0) == 0 ? kExitTool
                                                                           : kExitBadInput;
   }
-  const int W = ropt.width, H = ropt.height;
 
   std::signal(SIGPIPE, SIG_IGN);  // a dead ffmpeg shows up as a failed write, not a signal
   const std::string size = std::to_string(W) + "x" + std::to_string(H);
   char rate[32];
   std::snprintf(rate, sizeof(rate), "%.9g", opt.fps * opt.speedup);  // playback frame rate
-  ChildPipe ffmpeg;
   if (!opt.video.empty() &&
       !ffmpeg.Open({"ffmpeg",   "-hide_banner", "-loglevel", "error", "-y",    "-f",
                     "rawvideo", "-pix_fmt",     "rgb24",     "-s",    size,    "-r",
@@ -213,24 +269,14 @@ int Render(const RenderCliOptions& opt) {
     return kExitTool;
   }
 
-  DataPtr data = MakeData(m);
-  mjData* d = data.get();
-  Observer observer(m);
-  std::vector<unsigned char> rgb(static_cast<size_t>(3) * W * H);
-  const bool progress = isatty(2);
-  std::vector<double> frame_ms;
-  long long step = 0, next_png = 0, npng = 0;
-  int status = 0;
-  const auto start = std::chrono::steady_clock::now();
-  for (long long k = 0; k < nframes && status == 0; ++k) {
+  start = std::chrono::steady_clock::now();
+  for (long long k = 0; k < nframes; ++k) {
     // Frame k at step round(k / (fps h)).
     const long long target = mjtether::render::FrameStep(k, opt.fps, h);
     for (; step < target; ++step) {
       if (const int signal = StopSignal()) {
-        std::cerr << (progress ? "\n" : "") << "mjtether: " << opt.model << ": "
-                  << Interrupted(signal, d->time, step,
-                                 mjtether::render::FrameStep(nframes - 1, opt.fps, h))
-                  << "; the video keeps " << frame_ms.size() << " frame(s)\n";
+        interrupted = Interrupted(signal, d->time, step,
+                                  mjtether::render::FrameStep(nframes - 1, opt.fps, h));
         status = 128 + signal;
         break;
       }
@@ -244,42 +290,22 @@ int Render(const RenderCliOptions& opt) {
     // Still j at frame round(j * png_every * fps).
     const bool still = png_every > 0 && k >= std::llround(next_png * png_every * opt.fps);
     if (opt.video.empty() && !still) continue;
+    // Next still: the first one due after this frame (several may fall on one frame when the
+    // interval is shorter than a frame).
+    while (still && std::llround(next_png * png_every * opt.fps) <= k) ++next_png;
 
     mjtether::Prescribe(m, d);
     mjData* o = observer.Observe(d);  // the tether at d->time, on a copy
-    const auto t0 = std::chrono::steady_clock::now();
-    renderer->Render(m, o, rgb.data());
-    frame_ms.push_back(
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-    if (!opt.video.empty() && !ffmpeg.Write(rgb.data(), rgb.size())) {
-      status = kExitTool;  // ffmpeg stopped reading: its exit status is reported below
-      break;
-    }
-    if (still) {
-      char name[64];
-      std::snprintf(name, sizeof(name), "t_%09.3f.png", k * frame_dt);
-      const std::string path = (fs::path(png_dir) / name).string();
-      ToolOutput png;
-      if (!png.Open(path, "--png-every", &guard, &error)) {
-        std::cerr << (progress ? "\n" : "") << "mjtether: " << error << "\n";
-        status = kExitBadInput;
-        break;
-      }
-      if (!mjtether::render::WritePng(png.path(), rgb.data(), W, H, &error) ||
-          !png.Commit(&error)) {
-        std::cerr << (progress ? "\n" : "") << "mjtether: output error: " << error << "\n";
-        status = kExitOutput;
-        break;
-      }
-      // Next still: the first one due after this frame (several may fall on one frame when
-      // the interval is shorter than a frame).
-      while (std::llround(next_png * png_every * opt.fps) <= k) ++next_png;
-      ++npng;
-    }
-    if (progress) {
-      Progress(k + 1, nframes, d->time,
-               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-    }
+    if (!pipeline->Submit(o, k, still ? kStill : 0)) break;  // the sink set the status
+  }
+  // The frames in flight are written (the sink sets the status if that fails).
+  pipeline->Flush();
+  if (sink_status && !status) status = sink_status;
+  const int threads = pipeline->threads(), samples = pipeline->samples();
+  pipeline.reset();
+  if (!interrupted.empty()) {
+    std::cerr << (progress ? "\n" : "") << "mjtether: " << opt.model << ": " << interrupted
+              << "; the video keeps " << frame_ms.size() << " frame(s)\n";
   }
   if (progress) std::fprintf(stderr, "\n");
 
@@ -304,8 +330,10 @@ int Render(const RenderCliOptions& opt) {
     std::sort(sorted.begin(), sorted.end());
     const double median = sorted.empty() ? 0 : sorted[sorted.size() / 2];
     std::cerr << "mjtether: rendered " << frame_ms.size() << " frame(s) " << W << "x" << H << ", "
-              << renderer->samples() << " MSAA samples, tension scale 0-" << ropt.tension_max
-              << " N, in " << wall << " s (median " << median << " ms/frame)";
+              << samples << " MSAA samples, tension scale 0-" << ropt.tension_max << " N, in "
+              << wall << " s (" << 1000 * wall / std::max<size_t>(1, frame_ms.size())
+              << " ms/frame on " << threads << " render thread(s); median render " << median
+              << " ms)";
     if (!opt.video.empty()) std::cerr << "; video: " << opt.video;
     if (npng > 0) std::cerr << "; " << npng << " still(s) in " << png_dir;
     std::cerr << "\n";
@@ -341,7 +369,7 @@ std::function<int()> SetupRender(CLI::App* sub) {
   sub->add_option("--distance", opt->distance,
                   "camera distance for follow, top and track:BODY [m], fixed; or auto (default; "
                   "0 is a synonym): follow and top zoom to keep the tethers and vehicles in view, "
-                  "track uses 15 x the body's radius, at least 1 m")
+                  "track uses 8 x the body's radius, at least 1 m")
       ->check(mjtether::cli::Number(0, 1e6, false, "m"))
       ->transform(Auto());
   sub->add_option("--speedup", opt->speedup,
@@ -350,6 +378,12 @@ std::function<int()> SetupRender(CLI::App* sub) {
       ->check(mjtether::cli::Number(0.01, 1000, false, ""));
   sub->add_option("--vehicle", opt->vehicle, "body whose depth the HUD shows");
   sub->add_flag("--no-hud", opt->no_hud, "no text overlay or colour scale");
+  sub->add_option("--render-threads", opt->render_threads,
+                  "frames rendered in parallel, each with its own OSMesa context: 1 renders "
+                  "each frame in turn; auto (default; 0 is a synonym): 1 on up to 2 cores, where "
+                  "the pipeline does not pay, else one per core up to 4")
+      ->check(CLI::Range(0, 16))
+      ->transform(Auto());
   return [opt]() { return Render(*opt); };
 }
 

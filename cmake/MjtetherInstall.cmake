@@ -59,5 +59,9 @@ files, the Python module and example models.")
 # are run by `mjtether render` and `mjtether plot`.
 set(CPACK_DEBIAN_PACKAGE_DEPENDS
     "libc6, libstdc++6, libmujoco2.2.2, libmujoco-dev (>= 2.2.2), libeigen3-dev, libosmesa6, libpng16-16, python3 (>= 3.11), python3 (<< 3.12), python3-numpy")
+# `mjtether view` links GLFW when it was built.
+if(MJTETHER_CLI AND glfw3_FOUND)
+  string(APPEND CPACK_DEBIAN_PACKAGE_DEPENDS ", libglfw3")
+endif()
 set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "ffmpeg, gnuplot-nox")
 include(CPack)

@@ -47,6 +47,37 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
+// Fills api's GL functions (the fixed-function calls of DrawWater) from lookup(name). False,
+// with *error naming the first missing one, if one is missing.
+template <class Lookup>
+bool LoadGlFunctions(OsMesaApi* api, Lookup lookup, std::string* error) {
+  bool ok = true;
+  auto get = [&](auto& f, const char* symbol) {
+    f = reinterpret_cast<std::remove_reference_t<decltype(f)>>(lookup(symbol));
+    if (!f && ok) {
+      ok = false;
+      *error = std::string("has no ") + symbol;
+    }
+  };
+  get(api->PushAttrib, "glPushAttrib");
+  get(api->PopAttrib, "glPopAttrib");
+  get(api->Disable, "glDisable");
+  get(api->Enable, "glEnable");
+  get(api->DepthFunc, "glDepthFunc");
+  get(api->DepthMask, "glDepthMask");
+  get(api->Viewport, "glViewport");
+  get(api->MatrixMode, "glMatrixMode");
+  get(api->PushMatrix, "glPushMatrix");
+  get(api->PopMatrix, "glPopMatrix");
+  get(api->LoadIdentity, "glLoadIdentity");
+  get(api->ShadeModel, "glShadeModel");
+  get(api->Begin, "glBegin");
+  get(api->End, "glEnd");
+  get(api->Color3fv, "glColor3fv");
+  get(api->Vertex3f, "glVertex3f");
+  return ok;
+}
+
 // The OSMesa functions, or nullptr with *error set if the library cannot be opened.
 const OsMesaApi* OsMesa(std::string* error) {
   static OsMesaApi api;
@@ -74,22 +105,11 @@ const OsMesaApi* OsMesa(std::string* error) {
     get(api.CreateContextExt, "OSMesaCreateContextExt");
     get(api.MakeCurrent, "OSMesaMakeCurrent");
     get(api.DestroyContext, "OSMesaDestroyContext");
-    get(api.PushAttrib, "glPushAttrib");
-    get(api.PopAttrib, "glPopAttrib");
-    get(api.Disable, "glDisable");
-    get(api.Enable, "glEnable");
-    get(api.DepthFunc, "glDepthFunc");
-    get(api.DepthMask, "glDepthMask");
-    get(api.Viewport, "glViewport");
-    get(api.MatrixMode, "glMatrixMode");
-    get(api.PushMatrix, "glPushMatrix");
-    get(api.PopMatrix, "glPopMatrix");
-    get(api.LoadIdentity, "glLoadIdentity");
-    get(api.ShadeModel, "glShadeModel");
-    get(api.Begin, "glBegin");
-    get(api.End, "glEnd");
-    get(api.Color3fv, "glColor3fv");
-    get(api.Vertex3f, "glVertex3f");
+    std::string missing;
+    if (ok && !LoadGlFunctions(&api, [lib](const char* s) { return dlsym(lib, s); }, &missing)) {
+      ok = false;
+      load_error = "OSMesa: libOSMesa " + missing;
+    }
     if (!ok) api.CreateContextExt = nullptr;
   });
   if (!api.CreateContextExt) {
@@ -364,6 +384,22 @@ int Vehicle(const mjModel* m) {
 
 std::unique_ptr<Renderer> Renderer::Create(mjModel* m, const RenderOptions& options,
                                            std::string* error) {
+  return CreateIn(m, options, nullptr, error);
+}
+
+std::unique_ptr<Renderer> Renderer::CreateForWindow(mjModel* m, const RenderOptions& options,
+                                                    GlProcLoader load, std::string* error) {
+  if (!load) {
+    *error = "no GL function loader for the window";
+    return nullptr;
+  }
+  return CreateIn(m, options, load, error);
+}
+
+// window: null for an OSMesa context of the renderer's own, else the loader of the window's
+// context, current in this thread.
+std::unique_ptr<Renderer> Renderer::CreateIn(mjModel* m, const RenderOptions& options,
+                                             GlProcLoader window, std::string* error) {
   const RenderOptions& o = options;
   if (o.width < 16 || o.width > 4096 || o.height < 16 || o.height > 4096 || o.width % 2 ||
       o.height % 2) {
@@ -407,7 +443,12 @@ std::unique_ptr<Renderer> Renderer::Create(mjModel* m, const RenderOptions& opti
                         : L > 0        ? 1.25 * L
                                        : std::max(3.0, 2.0 * m->stat.extent);
   if (TetherCount(m) > 0) {
-    const Vec3& u = GetTether(m, 0)->env().water.current;
+    // Across the current: the uniform one, or a profile's fastest row.
+    const Water& w = GetTether(m, 0)->env().water;
+    Vec3 u = w.current;
+    for (const Vec3& row : w.profile.u) {
+      if (row.norm() > u.norm()) u = row;
+    }
     if (std::hypot(u.x(), u.y()) > 0) {
       r->follow_azimuth_ = std::atan2(u.y(), u.x()) * 180 / kPi + 90;
     }
@@ -424,7 +465,9 @@ std::unique_ptr<Renderer> Renderer::Create(mjModel* m, const RenderOptions& opti
       return nullptr;
     }
     r->track_body_ = b;
-    if (o.distance <= 0) r->follow_distance_ = std::max(1.0, 15 * BodySize(m, b));
+    // 8 radii: the sphere holding its geoms spans about 30 % of the frame's height (45 degree
+    // field of view), so a vehicle stays well above the 40 px of the close-up threshold at 360 rows.
+    if (o.distance <= 0) r->follow_distance_ = std::max(1.0, 8 * BodySize(m, b));
     if (o.vehicle.empty()) r->vehicle_ = b;
   } else if (c == "top") {
     r->top_ = true;
@@ -466,20 +509,34 @@ std::unique_ptr<Renderer> Renderer::Create(mjModel* m, const RenderOptions& opti
     }
   }
 
-  // OSMesa context with its own (unused) default framebuffer; MuJoCo draws off-screen.
-  const OsMesaApi* gl = OsMesa(error);
-  if (!gl) return nullptr;
-  r->gl_ = gl;
-  OSMesaContext ctx = gl->CreateContextExt(OSMESA_RGBA, 24, 8, 0, nullptr);
-  if (!ctx) {
-    *error = "OSMesa: cannot create a context (OSMesaCreateContextExt)";
-    return nullptr;
-  }
-  r->osmesa_ = ctx;
-  r->osmesa_buffer_.reset(new unsigned char[4 * o.width * o.height]);
-  if (!gl->MakeCurrent(ctx, r->osmesa_buffer_.get(), GL_UNSIGNED_BYTE, o.width, o.height)) {
-    *error = "OSMesa: cannot make the context current (OSMesaMakeCurrent)";
-    return nullptr;
+  r->options_cam_ = r->cam_;
+  if (window) {
+    // The window's context, current in this thread: its own GL functions.
+    r->window_ = true;
+    r->window_gl_ = std::make_unique<OsMesaApi>();
+    std::string missing;
+    if (!LoadGlFunctions(
+            r->window_gl_.get(), [window](const char* s) { return window(s); }, &missing)) {
+      *error = "OpenGL: the window's context " + missing;
+      return nullptr;
+    }
+    r->gl_ = r->window_gl_.get();
+  } else {
+    // OSMesa context with its own (unused) default framebuffer; MuJoCo draws off-screen.
+    const OsMesaApi* gl = OsMesa(error);
+    if (!gl) return nullptr;
+    r->gl_ = gl;
+    OSMesaContext ctx = gl->CreateContextExt(OSMESA_RGBA, 24, 8, 0, nullptr);
+    if (!ctx) {
+      *error = "OSMesa: cannot create a context (OSMesaCreateContextExt)";
+      return nullptr;
+    }
+    r->osmesa_ = ctx;
+    r->osmesa_buffer_.reset(new unsigned char[4 * o.width * o.height]);
+    if (!gl->MakeCurrent(ctx, r->osmesa_buffer_.get(), GL_UNSIGNED_BYTE, o.width, o.height)) {
+      *error = "OSMesa: cannot make the context current (OSMesaMakeCurrent)";
+      return nullptr;
+    }
   }
 
   // The off-screen buffer is sized from the model: set it to the requested size, since a larger
@@ -517,6 +574,10 @@ std::unique_ptr<Renderer> Renderer::Create(mjModel* m, const RenderOptions& opti
     mjr_defaultContext(&r->con_);
     r->context_made_ = false;
   }
+  if (window) {
+    mjr_setBuffer(mjFB_WINDOW, &r->con_);
+    return r;
+  }
   mjr_setBuffer(mjFB_OFFSCREEN, &r->con_);
   if (r->con_.currentBuffer != mjFB_OFFSCREEN) {
     *error = "MuJoCo: the off-screen framebuffer is not available";
@@ -532,7 +593,7 @@ std::unique_ptr<Renderer> Renderer::Create(mjModel* m, const RenderOptions& opti
 }
 
 Renderer::~Renderer() {
-  if (osmesa_) {
+  if (osmesa_) {  // (a window's context is current already)
     gl_->MakeCurrent(static_cast<OSMesaContext>(osmesa_), osmesa_buffer_.get(), GL_UNSIGNED_BYTE,
                      opt_.width, opt_.height);
   }
@@ -569,7 +630,7 @@ static std::vector<std::string> HudTitles(const mjModel* m, int vehicle, bool co
     t.push_back(compact ? "depth" : "depth of " + BodyName(m, vehicle));
     if (n > 0 && GetTether(m, 0)->env().water.has_seabed) t.push_back("altitude");
   }
-  if (n > 0 && GetTether(m, 0)->env().water.current.norm() > 0) t.push_back("current");
+  if (n > 0 && GetTether(m, 0)->env().water.has_current()) t.push_back("current");
   return t;
 }
 
@@ -606,7 +667,7 @@ void Renderer::ComputeLayout(const mjModel* m) {
       l.label = {left + (bar_w - title) / 2, l.scale.h - pad - ch, title, ch};
     }
   }
-  if (TetherCount(m) > 0 && GetTether(m, 0)->env().water.current.norm() > 0) {
+  if (TetherCount(m) > 0 && GetTether(m, 0)->env().water.has_current()) {
     const int w = std::max(W / 7, 4 * ch), h = std::max(H / 7, 3 * ch);
     l.arrow = {W - w, H - h, w, h};
   }
@@ -616,6 +677,7 @@ void Renderer::ComputeLayout(const mjModel* m) {
     l.pip = {pad, pad, w, h};
   }
   layout_ = l;
+  layout_dirty_ = false;
 }
 
 // Projected size [pixel] of body b's drawn geoms through pose p: the larger side of the box
@@ -723,6 +785,7 @@ CameraPose Renderer::Target(const mjModel* m, const mjData* d, bool pip) const {
 }
 
 CameraPose Renderer::NextPose(const mjModel* m, const mjData* d) {
+  if (layout_dirty_) ComputeLayout(m);  // (a window resized)
   CameraPose p;
   p.azimuth = follow_azimuth_;
   p.elevation = top_ ? -90 : kFollowElevation;
@@ -852,13 +915,17 @@ void Renderer::Decorate(const mjModel* m, const mjData* d, double D, bool overla
   }
 
   // Current: an arrow in the top-right rectangle, 0.5 D per m/s, at most 70 % of its width.
-  const double speed = w.current.norm();
+  // With a current profile, the current at the depth of the view's centre (the reference
+  // point), which the HUD shows too.
+  const Vec3 current = w.CurrentAt(ref.z());
+  const double speed = current.norm();
+  if (overlays) current_shown_ = speed;
   const Rect& box = layout_.arrow;
   if (overlays && speed > 0 && !box.empty()) {
     if (mjvGeom* g = NextGeom(&scn_)) {
       const double W = opt_.width, H = opt_.height;
       const double per_px = 2 * D * t / H;  // [m] per pixel at depth D
-      const Vec3 dir = w.current / speed;
+      const Vec3 dir = current / speed;
       const double len = std::min(0.5 * D * speed, 0.7 * box.w * per_px);
       const double cx = box.x + 0.5 * box.w - 0.5 * W, cy = box.y + 0.5 * box.h - 0.5 * H;
       const Vec3 c = ref + cx * per_px * right + cy * per_px * up;
@@ -907,8 +974,8 @@ void Renderer::DrawHud(const mjModel* m, const mjData* d) {
       values.push_back(buf);
     }
   }
-  if (TetherCount(m) > 0 && GetTether(m, 0)->env().water.current.norm() > 0) {
-    std::snprintf(buf, sizeof(buf), "%.2f m/s", GetTether(m, 0)->env().water.current.norm());
+  if (TetherCount(m) > 0 && GetTether(m, 0)->env().water.has_current()) {
+    std::snprintf(buf, sizeof(buf), "%.2f m/s", current_shown_);  // as the arrow (Decorate)
     values.push_back(buf);
   }
   const Rect& hud = layout_.hud;
@@ -998,33 +1065,48 @@ void Renderer::Fog(double D) {
   std::copy(kFog, kFog + 4, con_.fogRGBA);
 }
 
+// Makes the renderer's context current (OSMesa) and selects the buffer MuJoCo draws into.
+void Renderer::BeginFrame() {
+  if (window_) {
+    mjr_setBuffer(mjFB_WINDOW, &con_);
+    return;
+  }
+  gl_->MakeCurrent(static_cast<OSMesaContext>(osmesa_), osmesa_buffer_.get(), GL_UNSIGNED_BYTE,
+                   opt_.width, opt_.height);
+  mjr_setBuffer(mjFB_OFFSCREEN, &con_);
+}
+
 void Renderer::Render(const mjModel* m, mjData* d, unsigned char* rgb, float* depth) {
-  RenderAt(m, d, NextPose(m, d), rgb, depth);
+  // A camera the caller moves has no filter to advance.
+  RenderAt(m, d, free_camera_ ? CameraPose() : NextPose(m, d), rgb, depth);
 }
 
 void Renderer::RenderAt(const mjModel* m, mjData* d, const CameraPose& pose, unsigned char* rgb,
                         float* depth) {
-  gl_->MakeCurrent(static_cast<OSMesaContext>(osmesa_), osmesa_buffer_.get(), GL_UNSIGNED_BYTE,
-                   opt_.width, opt_.height);
-  mjr_setBuffer(mjFB_OFFSCREEN, &con_);
-  const bool free_camera = cam_.type == mjCAMERA_FREE;
-  if (free_camera) {
+  BeginFrame();
+  if (layout_dirty_) ComputeLayout(m);
+  // The pose places the follow, top and track cameras; a model's camera and a camera the caller
+  // moves (the viewer's mouse) ignore it.
+  const bool posed = cam_.type == mjCAMERA_FREE && !free_camera_;
+  if (posed) {
     for (int i = 0; i < 3; ++i) cam_.lookat[i] = pose.lookat[i];
     cam_.distance = pose.distance;
     cam_.azimuth = pose.azimuth;
     cam_.elevation = pose.elevation;
   }
-  const double D = free_camera ? pose.distance : follow_distance_;
+  const double D = cam_.type == mjCAMERA_FREE ? cam_.distance : follow_distance_;
   mjv_updateScene(m, d, &vopt_, nullptr, &cam_, mjCAT_ALL, &scn_);
   Decorate(m, d, D, true);
+  if (opt_.overlay) DrawOverlay(m, d, D);
   Fog(D);
   const Rect all = {0, 0, opt_.width, opt_.height};
   mjr_render({0, 0, opt_.width, opt_.height}, &scn_, &con_);
   DrawWater(all);
+  if (opt_.overlay) DrawOverlayLabels(m, d);
 
   // Close-up of the vehicle, bottom left, framed by a thin light border.
   pip_rendered_ = false;
-  if (free_camera && pose.pip && vehicle_ >= 0 && !layout_.pip.empty()) {
+  if (posed && pose.pip && vehicle_ >= 0 && !layout_.pip.empty()) {
     const mjvGLCamera main[2] = {scn_.camera[0], scn_.camera[1]};
     const CameraPose pp = PipPose(m, d, pose);
     mjvCamera cam = cam_;
@@ -1045,7 +1127,49 @@ void Renderer::RenderAt(const mjModel* m, mjData* d, const CameraPose& pose, uns
   }
   if (opt_.hud) DrawHud(m, d);
 
-  mjr_readPixels(rgb, depth, {0, 0, opt_.width, opt_.height}, &con_);
+  if (rgb || depth) mjr_readPixels(rgb, depth, {0, 0, opt_.width, opt_.height}, &con_);
+}
+
+void Renderer::Caption(const std::string& left, const std::string& right) {
+  const mjrRect view = {0, 0, opt_.width, opt_.height};
+  mjr_overlay(mjFONT_NORMAL, mjGRID_BOTTOMLEFT, view, left.c_str(), right.c_str(), &con_);
+}
+
+void Renderer::ReadPixels(unsigned char* rgb, float* depth) {
+  const mjrRect view = {0, 0, opt_.width, opt_.height};
+  mjr_readPixels(rgb, depth, view, &con_);
+}
+
+void Renderer::Resize(int width, int height) {
+  if (!window_) return;  // an OSMesa buffer keeps its size
+  width = std::max(16, width);
+  height = std::max(16, height);
+  if (width == opt_.width && height == opt_.height) return;
+  opt_.width = width;
+  opt_.height = height;
+  layout_dirty_ = true;  // the overlays' places follow the frame
+}
+
+void Renderer::set_hud(bool on) {
+  opt_.hud = on;
+  layout_dirty_ = true;
+}
+
+void Renderer::set_tension_max(double T) {
+  opt_.tension_max = T;
+  layout_dirty_ = true;  // the scale's labels may change width
+}
+
+void Renderer::SetFreeCamera(const mjModel* m, bool free) {
+  if (free && !free_camera_ && cam_.type != mjCAMERA_FREE) {
+    // From a model's fixed camera: MuJoCo's default free view of the model.
+    mjv_defaultFreeCamera(m, &cam_);
+  }
+  if (!free && free_camera_) {
+    cam_ = options_cam_;
+    filter_started_ = false;  // the follow/top camera starts again from the current state
+  }
+  free_camera_ = free;
 }
 
 }  // namespace mjtether::render

@@ -6,7 +6,8 @@
 //   - the seabed (a sand-coloured slab at the declared height, unless the model has a plane
 //     there), a translucent water surface at z = 0 when a tether end starts within 1 m of it,
 //     fog toward the water's colour with distance (wet scenes), and an arrow along the current
-//     (top right), length proportional to its speed;
+//     (top right), length proportional to its speed (with a current profile, the current at
+//     the depth of the view's centre);
 //   - a HUD: time, the tension at each end of every tether, the vehicle's depth (top left), and
 //     the labelled colour scale (bottom right), both sized from the frame with MuJoCo's font
 //     metrics;
@@ -28,9 +29,10 @@
 //
 // Render(m, d, rgb) = RenderAt(m, d, NextPose(m, d), rgb): NextPose advances the camera's filter
 // (call it once per frame, in frame order) and costs no GL work, so a pipeline can compute the
-// poses in order and render the frames elsewhere with RenderAt.
+// poses in order and render the frames elsewhere with RenderAt (render/pipeline.h does).
 //
-// One Renderer per thread: it makes its OSMesa context current on Create and Render.
+// One Renderer per thread: it makes its OSMesa context current on Create and Render. Several
+// renderers may render in parallel threads.
 #ifndef MJTETHER_PLUGIN_RENDER_H_
 #define MJTETHER_PLUGIN_RENDER_H_
 
@@ -55,7 +57,7 @@ struct RenderOptions {
   // <camera> in the model.
   std::string camera = "follow";
   // [m] of the follow, top and track cameras; <= 0 (auto): follow and top zoom to frame the
-  // scene, track uses 15 x the radius of the body's geoms, at least 1 m.
+  // scene, track uses 8 x the radius of the body's geoms, at least 1 m.
   double distance = 0;
   double smoothing = 1;      // [s] time constant of the follow/top camera filter; 0: none
   double pip_min_px = 40;    // [pixel] close-up below this vehicle size (follow, top); 0: never
@@ -63,7 +65,12 @@ struct RenderOptions {
   std::string vehicle;       // body whose depth the HUD shows; empty: found (see Vehicle)
   bool hud = true;           // draw the HUD and the colour scale
   bool draw_tethers = true;  // draw the tethers (tests compare with and without)
+  // Each node as a white sphere and segment tensions [N] as labels (the viewer's O key).
+  bool overlay = false;
 };
+
+// A GL context's function loader (glfwGetProcAddress, for instance).
+using GlProcLoader = void* (*)(const char* name);
 
 // A "nice" upper bound for a colour scale with ticks at quarters: the smallest 1, 2, 3, 4, 5, 6
 // or 8 times a power of ten that is at least x (x > 0); 1 for x <= 0.
@@ -128,6 +135,12 @@ class Renderer {
   // off-screen buffer failure).
   static std::unique_ptr<Renderer> Create(mjModel* m, const RenderOptions& options,
                                           std::string* error);
+  // The same scene, drawn into the window whose OpenGL context is current in the calling
+  // thread (GLFW's, for `mjtether view`) instead of an OSMesa context: options.width and height
+  // are its framebuffer's size, `load` gives the context's GL functions. The context must be
+  // current for Render and when the renderer is destroyed.
+  static std::unique_ptr<Renderer> CreateForWindow(mjModel* m, const RenderOptions& options,
+                                                   GlProcLoader load, std::string* error);
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
@@ -135,13 +148,34 @@ class Renderer {
   // Renders d as it is (call mj_forward first so the tethers are at d->time) into rgb
   // (3 x width x height bytes, rows bottom-up); depth (width x height, [0, 1], 1 = far) too
   // if not null.
+  // rgb and depth may be null (a window's renderer draws into its window).
   void Render(const mjModel* m, mjData* d, unsigned char* rgb, float* depth = nullptr);
 
   // The camera for the frame at d->time: advances the follow/top filter (frames in order).
   CameraPose NextPose(const mjModel* m, const mjData* d);
-  // Renders d through a pose from NextPose (ignored for a camera of the model).
+  // Renders d through a pose from NextPose (ignored for a camera of the model and for a free
+  // camera the caller moves).
   void RenderAt(const mjModel* m, mjData* d, const CameraPose& pose, unsigned char* rgb,
                 float* depth = nullptr);
+
+  // Interactive use (`mjtether view`), after Render:
+  // - a line of text in the bottom-left corner, over what Render drew;
+  void Caption(const std::string& left, const std::string& right);
+  // - the pixels as they are now (3 x width x height bytes, rows bottom-up), caption included.
+  void ReadPixels(unsigned char* rgb, float* depth = nullptr);
+  // A window's new framebuffer size [pixel] (>= 16); the overlays are laid out again.
+  void Resize(int width, int height);
+  // The camera. Free: Render keeps it as the caller moved it (mjv_moveCamera); not free: the
+  // camera of the options, placed from the state at each frame as in videos.
+  mjvCamera* camera() { return &cam_; }
+  void SetFreeCamera(const mjModel* m, bool free);
+  bool free_camera() const { return free_camera_; }
+  void set_overlay(bool on) { opt_.overlay = on; }
+  bool overlay() const { return opt_.overlay; }
+  void set_hud(bool on);
+  bool hud() const { return opt_.hud; }
+  void set_tension_max(double T);  // [N]
+  double tension_max() const { return opt_.tension_max; }
 
   // The scene of the last Render; its camera is the main view's (scene().camera[0] and [1]
   // give the projection), also when a close-up was drawn after it.
@@ -161,6 +195,11 @@ class Renderer {
 
  private:
   Renderer() = default;
+  static std::unique_ptr<Renderer> CreateIn(mjModel* m, const RenderOptions& options,
+                                            GlProcLoader window, std::string* error);
+  void BeginFrame();
+  void DrawOverlay(const mjModel* m, const mjData* d, double distance);
+  void DrawOverlayLabels(const mjModel* m, const mjData* d);
   CameraPose Target(const mjModel* m, const mjData* d, bool pip) const;
   void Decorate(const mjModel* m, const mjData* d, double distance, bool overlays);
   void DrawHud(const mjModel* m, const mjData* d);
@@ -198,6 +237,12 @@ class Renderer {
   bool filter_started_ = false;
   double filter_time_ = 0;  // [s] simulated time of the last pose
   double state_[4] = {0, 0, 0, 0}, rate_[4] = {0, 0, 0, 0};
+  bool window_ = false;                   // drawing into a window's context, not OSMesa's
+  std::unique_ptr<OsMesaApi> window_gl_;  // the window context's GL functions
+  mjvCamera options_cam_;                 // the camera of the options, as Create set it
+  bool free_camera_ = false;              // the caller moves cam_
+  bool layout_dirty_ = false;             // size, HUD or scale changed: ComputeLayout again
+  double current_shown_ = 0;              // [m/s] the current's speed the last arrow showed
 };
 
 }  // namespace mjtether::render

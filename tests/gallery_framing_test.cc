@@ -1,0 +1,274 @@
+// The gallery's framing in every frame (issue 16, "each video shows the vehicle in every
+// frame"): for each `render` command of renders/make_gallery.sh (read from the script, so a new
+// gallery scene is checked without editing this file), the frames that command renders are
+// posed as `mjtether render` poses them (same frame grid, same stills-only skipping, same
+// automatic colour scale, same size and camera), and in every one
+//   - the vehicle's projected box is inside the frame and at least 40 px, or the close-up is
+//     shown and the box is inside it and at least 40 px there;
+//   - with the follow and top cameras, every tether node projects inside the frame and outside
+//     the HUD's and the colour scale's rectangles (track:BODY looks at the body only: the
+//     tether may leave the frame and pass under the HUD; not checked).
+// Posing needs no GL work (Renderer::NextPose, PipPose, ProjectPose), so every frame of every
+// scene costs about as much as simulating it. The projection is checked against the GL camera
+// MuJoCo renders with on one frame per scene (written here from the GL camera's fields), so
+// that ProjectPose is not trusted blindly.
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <ostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "mjtether.h"
+#include "render.h"
+
+namespace mjtether::render {
+namespace {
+
+// A `render` command of the gallery script.
+struct GalleryRender {
+  std::string model;  // path from the top of the repository
+  double duration = 0, fps = 30, png_every = 0;
+  int width = 1280, height = 720;
+  std::string camera = "follow";
+  bool video = false;
+  std::string line;  // the command, for messages
+};
+
+void PrintTo(const GalleryRender& g, std::ostream* os) { *os << g.line; }
+
+// The `$M render ...` commands of renders/make_gallery.sh (continuation lines joined).
+std::vector<GalleryRender> ReadGallery() {
+  std::ifstream in(std::string(MJTETHER_SOURCE_DIR) + "/renders/make_gallery.sh");
+  std::vector<GalleryRender> out;
+  std::string line, joined;
+  while (std::getline(in, line)) {
+    const bool more = !line.empty() && line.back() == '\\';
+    joined += more ? line.substr(0, line.size() - 1) : line;
+    if (more) continue;
+    std::istringstream words(joined);
+    std::vector<std::string> w;
+    for (std::string s; words >> s;) w.push_back(s);
+    if (w.size() >= 3 && w[0] == "$M" && w[1] == "render") {
+      GalleryRender g;
+      g.model = w[2];
+      g.line = joined;
+      for (size_t i = 3; i + 1 < w.size(); ++i) {
+        if (w[i] == "--duration") g.duration = std::stod(w[i + 1]);
+        if (w[i] == "--fps") g.fps = std::stod(w[i + 1]);
+        if (w[i] == "--png-every") g.png_every = std::stod(w[i + 1]);
+        if (w[i] == "--camera") g.camera = w[i + 1];
+        if (w[i] == "--video") g.video = true;
+        if (w[i] == "--size") std::sscanf(w[i + 1].c_str(), "%dx%d", &g.width, &g.height);
+      }
+      out.push_back(g);
+    }
+    joined.clear();
+  }
+  return out;
+}
+
+struct ModelDeleter {
+  void operator()(mjModel* m) const {
+    Detach(m);
+    mj_deleteModel(m);
+  }
+};
+
+// Box bounding the projections of the corners of body b's visible geoms (groups 0-2, not
+// transparent) through pose p in a W x H viewport: {xmin, ymin, xmax, ymax}.
+std::array<double, 4> BodyBox(const mjModel* m, const mjData* d, int b, const CameraPose& p, int W,
+                              int H) {
+  std::array<double, 4> box = {1e300, 1e300, -1e300, -1e300};
+  for (int g = 0; g < m->ngeom; ++g) {
+    if (m->geom_bodyid[g] != b || m->geom_group[g] > 2 || m->geom_rgba[4 * g + 3] == 0) continue;
+    const double* s = m->geom_size + 3 * g;
+    double e[3] = {s[0], s[1], s[2]};
+    if (m->geom_type[g] == mjGEOM_SPHERE) e[1] = e[2] = s[0];
+    if (m->geom_type[g] == mjGEOM_CYLINDER) e[1] = s[0], e[2] = s[1];
+    if (m->geom_type[g] == mjGEOM_CAPSULE) e[1] = s[0], e[2] = s[0] + s[1];
+    for (int corner = 0; corner < 8; ++corner) {
+      double local[3], world[3];
+      for (int i = 0; i < 3; ++i) local[i] = (corner >> i & 1 ? 1 : -1) * e[i];
+      mju_rotVecMat(world, local, d->geom_xmat + 9 * g);
+      mju_addTo3(world, d->geom_xpos + 3 * g);
+      const std::array<double, 2> px = ProjectPose(p, m->vis.global.fovy, W, H, world);
+      box[0] = std::min(box[0], px[0]), box[1] = std::min(box[1], px[1]);
+      box[2] = std::max(box[2], px[0]), box[3] = std::max(box[3], px[1]);
+    }
+  }
+  return box;
+}
+
+// Pixel where p projects through the GL camera c in a W x H viewport, as mjr_render sets up
+// OpenGL (look-at from pos along forward with up; frustum at the near plane).
+std::array<double, 2> ProjectGl(const mjvGLCamera& c, int W, int H, const double* p) {
+  double v[3], right[3];
+  for (int i = 0; i < 3; ++i) v[i] = p[i] - c.pos[i];
+  const double f[3] = {c.forward[0], c.forward[1], c.forward[2]};
+  const double u[3] = {c.up[0], c.up[1], c.up[2]};
+  mju_cross(right, f, u);
+  const double z = mju_dot3(v, f);
+  const double xn = c.frustum_near * mju_dot3(v, right) / z;
+  const double yn = c.frustum_near * mju_dot3(v, u) / z;
+  const double half_w = 0.5 * W / H * (c.frustum_top - c.frustum_bottom);
+  const double left = c.frustum_center - half_w;
+  return {W * (xn - left) / (2 * half_w),
+          H * (yn - c.frustum_bottom) / (c.frustum_top - c.frustum_bottom)};
+}
+
+// The largest tension over the frames' instants, rounded up as `render --tension-max auto`
+// does (the colour scale's labels set its width, so the layout).
+double AutoTensionMax(const mjModel* m, const GalleryRender& g, long long nframes) {
+  mjData* d = mj_makeData(m);
+  mjData* o = mj_makeData(m);
+  std::vector<double> T;
+  double tmax = 0;
+  long long step = 0;
+  for (long long k = 0; k < nframes; ++k) {
+    for (; step < FrameStep(k, g.fps, m->opt.timestep); ++step) Step(m, d);
+    Prescribe(m, d);
+    mj_copyData(o, m, d);
+    mj_forward(m, o);
+    for (int t = 0; t < TetherCount(m); ++t) {
+      T.resize(GetTether(m, t)->segments());
+      GetTensions(m, o, t, T.data());
+      for (double x : T) tmax = std::max(tmax, x);
+      const EndReactions r = GetReactions(m, o, t);
+      tmax = std::max({tmax, r.tension_a, r.tension_b});
+    }
+  }
+  mj_deleteData(o);
+  mj_deleteData(d);
+  return NiceCeil(tmax);
+}
+
+class Gallery : public ::testing::TestWithParam<GalleryRender> {};
+
+TEST(GalleryScript, HasRenderCommands) {
+  // The script is read, and holds the scenes the gallery shows (so an empty parse cannot pass).
+  EXPECT_GE(ReadGallery().size(), 8u);
+}
+
+TEST_P(Gallery, VehicleSeenAndTetherOffTheOverlaysInEveryFrame) {
+  const GalleryRender& g = GetParam();
+  std::string error;
+  std::unique_ptr<mjModel, ModelDeleter> model(
+      LoadModel(std::string(MJTETHER_SOURCE_DIR) + "/" + g.model, &error));
+  ASSERT_NE(model, nullptr) << error;
+  mjModel* m = model.get();
+  const long long nframes = static_cast<long long>(std::floor(g.duration * g.fps + 1e-9)) + 1;
+  RenderOptions opt;
+  opt.width = g.width;
+  opt.height = g.height;
+  opt.samples = 0;  // one frame is rendered, to compare projections
+  opt.camera = g.camera;
+  opt.tension_max = AutoTensionMax(m, g, nframes);
+  std::unique_ptr<Renderer> r = Renderer::Create(m, opt, &error);
+  ASSERT_NE(r, nullptr) << error;
+  const int vehicle = Vehicle(m);
+  ASSERT_GE(vehicle, 0) << g.model;
+  const bool framed = g.camera == "follow" || g.camera == "top";
+  const int W = g.width, H = g.height;
+  const double fovy = m->vis.global.fovy;
+
+  mjData* d = mj_makeData(m);
+  mjData* o = mj_makeData(m);
+  std::vector<unsigned char> rgb(3 * W * H);
+  long long step = 0, next_png = 0;
+  int posed = 0, closeups = 0, failures = 0;
+  double smallest = 1e300;
+  bool compared = false;
+  for (long long k = 0; k < nframes && failures < 10; ++k) {
+    for (; step < FrameStep(k, g.fps, m->opt.timestep); ++step) Step(m, d);
+    // As cli_render.cc: without a video, only the stills' frames are rendered (and posed).
+    const bool still = g.png_every > 0 && k >= std::llround(next_png * g.png_every * g.fps);
+    if (!g.video && !still) continue;
+    while (still && std::llround(next_png * g.png_every * g.fps) <= k) ++next_png;
+    Prescribe(m, d);
+    mj_copyData(o, m, d);
+    mj_forward(m, o);
+    const CameraPose pose = r->NextPose(m, o);
+    ++posed;
+    const std::string at = g.model + " " + g.camera + " t = " + std::to_string(o->time) + " s";
+
+    // Once per scene (halfway): ProjectPose against the GL camera MuJoCo rendered with, to
+    // 0.5 px (both are the same pinhole model; float GL fields give ~1e-4 px).
+    if (!compared && k >= nframes / 2) {
+      compared = true;
+      r->RenderAt(m, o, pose, rgb.data());
+      const mjvGLCamera c = mjv_averageCamera(&r->scene().camera[0], &r->scene().camera[1]);
+      const double* x = o->xpos + 3 * vehicle;
+      const std::array<double, 2> a = ProjectPose(pose, fovy, W, H, x), b = ProjectGl(c, W, H, x);
+      EXPECT_NEAR(a[0], b[0], 0.5) << at;
+      EXPECT_NEAR(a[1], b[1], 0.5) << at;
+    }
+
+    const Layout l = r->layout();
+    std::array<double, 4> box;
+    int bw = W, bh = H;
+    if (pose.pip) {
+      ++closeups;
+      bw = l.pip.w, bh = l.pip.h;
+      box = BodyBox(m, o, vehicle, r->PipPose(m, o, pose), bw, bh);
+    } else {
+      box = BodyBox(m, o, vehicle, pose, W, H);
+    }
+    const double size = std::max(box[2] - box[0], box[3] - box[1]);
+    smallest = std::min(smallest, size);
+    std::ostringstream why;
+    if (!(box[0] >= 0 && box[1] >= 0 && box[2] <= bw && box[3] <= bh)) {
+      why << " vehicle box (" << box[0] << ", " << box[1] << ") - (" << box[2] << ", " << box[3]
+          << ") not inside " << bw << "x" << bh << (pose.pip ? " (close-up);" : ";");
+    }
+    if (!(size >= 40)) why << " vehicle " << size << " px" << (pose.pip ? " (close-up);" : ";");
+    if (framed) {
+      for (int t = 0; t < TetherCount(m); ++t) {
+        const double* x = NodePositions(m, o, t);
+        for (int i = 0; i < GetTether(m, t)->nodes(); ++i) {
+          const std::array<double, 2> p = ProjectPose(pose, fovy, W, H, x + 3 * i);
+          if (!(p[0] >= 0 && p[0] <= W && p[1] >= 0 && p[1] <= H)) {
+            why << " node " << i << " outside, at (" << p[0] << ", " << p[1] << ");";
+          }
+          if (l.hud.Contains(p[0], p[1])) why << " node " << i << " under the HUD;";
+          if (l.scale.Contains(p[0], p[1])) why << " node " << i << " under the scale;";
+        }
+      }
+    }
+    if (!why.str().empty()) {
+      ADD_FAILURE() << at << ":" << why.str();
+      ++failures;  // (the first 10 failing frames are reported)
+    }
+  }
+  EXPECT_TRUE(compared) << g.model;
+  EXPECT_GE(posed, 1);
+  std::printf("%s %s %dx%d: %d frame(s) posed, %d with the close-up; smallest vehicle %.0f px\n",
+              g.model.c_str(), g.camera.c_str(), W, H, posed, closeups, smallest);
+  r.reset();
+  mj_deleteData(o);
+  mj_deleteData(d);
+}
+
+INSTANTIATE_TEST_SUITE_P(Renders, Gallery, ::testing::ValuesIn(ReadGallery()),
+                         [](const ::testing::TestParamInfo<GalleryRender>& info) {
+                           std::string name = info.param.model;
+                           name = name.substr(name.rfind('/') + 1);
+                           name = name.substr(0, name.find('.'));
+                           name += "_" + std::to_string(info.param.width) + "_" +
+                                   std::to_string(info.index);
+                           for (char& c : name) {
+                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                           }
+                           return name;
+                         });
+
+}  // namespace
+}  // namespace mjtether::render
