@@ -6,7 +6,7 @@
 //   mjtether plot TABLE.csv --x COL --y COL [--by COL] --out FILE.png   (cli_plot_columns.h)
 //
 // INPUT ending in .csv is read as a run log (columns time, NAME.tension_A, NAME.tension_B,
-// BODY.z); otherwise it is a model, run for --duration seconds and sampled every --every
+// BODY.z, and NAME.length, NAME.payout_speed with a winch: two more panels); otherwise it is a model, run for --duration seconds and sampled every --every
 // seconds (scheduled by step index, as `mjtether run` does).
 #include <algorithm>
 #include <cmath>
@@ -61,11 +61,13 @@ bool RefuseIgnored(const PlotOptions& opt, std::initializer_list<const char*> na
   return false;
 }
 
-// The series to plot: time [s], tension at ends A and B [N], vehicle height z [m].
+// The series to plot: time [s], tension at ends A and B [N], vehicle height z [m]; with a
+// winch (docs/winch.md), the deployed length [m] and the payout speed [m/s].
 struct Series {
   std::string title;
   std::string label_a = "end A", label_b = "end B", vehicle;
-  std::vector<double> t, ta, tb, z;
+  bool winch = false;
+  std::vector<double> t, ta, tb, z, length, speed;
 };
 
 bool EndsWith(const std::string& s, const std::string& suffix) {
@@ -100,6 +102,8 @@ bool ReadLog(const PlotOptions& opt, Series* s, std::string* error) {
   const int ct = find("time"), ca = find(tether + ".tension_A"), cb = find(tether + ".tension_B");
   const int cz = body.empty() ? -1 : find(body + ".z");
   const int n = static_cast<int>(head.size());
+  const int cl = find(tether + ".length"), cv = find(tether + ".payout_speed");
+  s->winch = cl < n && cv < n;
   if (ct >= n || ca >= n || cb >= n || tether.empty()) {
     *error = opt.input + ": no columns time, " + (tether.empty() ? "NAME" : tether) +
              ".tension_A and .tension_B (write the log with mjtether run --log)";
@@ -118,9 +122,9 @@ bool ReadLog(const PlotOptions& opt, Series* s, std::string* error) {
     ++row;
     if (line.empty()) continue;
     const std::vector<std::string> v = SplitCsv(line);
-    double value[4] = {0, 0, 0, 0};
-    const int columns[4] = {ct, ca, cb, cz < n ? cz : -1};
-    for (int c = 0; c < 4; ++c) {
+    double value[6] = {0, 0, 0, 0, 0, 0};
+    const int columns[6] = {ct, ca, cb, cz < n ? cz : -1, s->winch ? cl : -1, s->winch ? cv : -1};
+    for (int c = 0; c < 6; ++c) {
       if (columns[c] < 0) continue;
       const std::string field =
           columns[c] < static_cast<int>(v.size()) ? v[columns[c]] : std::string("(missing)");
@@ -137,6 +141,8 @@ bool ReadLog(const PlotOptions& opt, Series* s, std::string* error) {
     s->ta.push_back(value[1]);
     s->tb.push_back(value[2]);
     s->z.push_back(value[3]);
+    s->length.push_back(value[4]);
+    s->speed.push_back(value[5]);
   }
   return true;
 }
@@ -178,6 +184,7 @@ int RunModel(const PlotOptions& opt, const mjModel* m, Series* s) {
 
   DataPtr data = MakeData(m);
   mjData* d = data.get();
+  s->winch = mjtether::GetWinch(m, d, k).present;
   Observer observer(m);
   const double h = m->opt.timestep;
   const long long steps = std::llround(opt.duration / h);
@@ -196,6 +203,9 @@ int RunModel(const PlotOptions& opt, const mjModel* m, Series* s) {
       s->ta.push_back(r.tension_a);
       s->tb.push_back(r.tension_b);
       s->z.push_back(vehicle >= 0 ? o->xpos[3 * vehicle + 2] : 0.0);
+      const mjtether::WinchState w = mjtether::GetWinch(m, o, k);
+      s->length.push_back(w.length);
+      s->speed.push_back(w.payout_speed);
       next = std::llround(++index * every / h);
     }
     if (i == steps) break;
@@ -275,23 +285,33 @@ int Plot(const PlotOptions& opt) {
     return kExitBadInput;
   }
 
-  // Two panels sharing the time axis: end tensions, then the vehicle's depth (-z, downwards).
+  // Panels sharing the time axis: end tensions; with a winch, the deployed length and the
+  // payout speed; then the vehicle's depth (-z, downwards).
   std::ostringstream g;
   g.precision(9);
   g << "$data << EOD\n";
   for (size_t i = 0; i < s.t.size(); ++i) {
-    g << s.t[i] << " " << s.ta[i] << " " << s.tb[i] << " " << -s.z[i] << "\n";
+    g << s.t[i] << " " << s.ta[i] << " " << s.tb[i] << " " << -s.z[i] << " " << s.length[i]
+      << " " << s.speed[i] << "\n";
   }
   g << "EOD\n"
     << "set terminal pngcairo size " << W << "," << H << " font 'sans,11'\n"
     << "set output " << Quote(out.path()) << "\n"
-    << "set multiplot layout " << (s.vehicle.empty() ? 1 : 2) << ",1 title " << Quote(s.title)
+    << "set multiplot layout " << (s.vehicle.empty() ? 1 : 2) + (s.winch ? 2 : 0)
+    << ",1 title " << Quote(s.title)
     << " noenhanced\n"
     << "set grid\nset key outside below center horizontal noenhanced\nset lmargin 12\n"
     << "set ylabel 'tension [N]'\n"
-    << (s.vehicle.empty() ? "set xlabel 'time [s]'\n" : "")
+    << (s.vehicle.empty() && !s.winch ? "set xlabel 'time [s]'\n" : "")
     << "plot $data using 1:2 with lines lw 2 lc rgb '#1f77b4' title " << Quote(s.label_a)
     << ", $data using 1:3 with lines lw 2 lc rgb '#d62728' title " << Quote(s.label_b) << "\n";
+  if (s.winch) {
+    g << "set ylabel 'length [m]'\nplot $data using 1:5 with lines lw 2 lc rgb '#9467bd' "
+         "title 'deployed length (winch)'\n"
+      << (s.vehicle.empty() ? "set xlabel 'time [s]'\n" : "")
+      << "set ylabel 'speed [m/s]'\nplot $data using 1:6 with lines lw 2 lc rgb '#8c564b' "
+         "title 'payout speed (> 0 paying out)'\n";
+  }
   if (!s.vehicle.empty()) {
     g << "set xlabel 'time [s]'\nset ylabel 'depth [m]'\nset yrange [*:*] reverse\n"
       << "plot $data using 1:4 with lines lw 2 lc rgb '#2ca02c' title "

@@ -989,8 +989,11 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
                                "' is free; the winch's end must be attached (end=A)");
       }
       if (p.effects & kContact) {
-        return fail(wname, "a winch with the contact effect is not supported yet; remove "
-                           "contact= from <text name=\"" + name + "\">");
+        // The contact candidate lists are sized at load for the tether's declared segments,
+        // not for max_length, and an inserted node has no candidates yet (docs/winch.md).
+        return fail(wname, "the tether's key 'contact' is not supported with a winch: "
+                           "remove contact= from <text name=\"" + name +
+                               "\"> or remove the winch");
       }
       if (!(p.length >= w.min_length && p.length <= w.max_length)) {
         s << "key 'min_length'/'max_length': the tether's length " << p.length

@@ -429,11 +429,22 @@ std::unique_ptr<Renderer> Renderer::CreateIn(mjModel* m, const RenderOptions& op
     r->vehicle_ = Vehicle(m);
   }
 
-  // Bodies framed with the tethers: those with a free joint.
+  // Bodies framed with the tethers: those with a free joint, and the bodies (not the world)
+  // that hold a tether's end with geoms of their own: a TMS or a boat, which would otherwise be
+  // cut at the frame's edge when the tether leaves it from below.
   r->body_radius_.resize(m->nbody);
   for (int b = 0; b < m->nbody; ++b) r->body_radius_[b] = BodySize(m, b);
   for (int j = 0; j < m->njnt; ++j) {
     if (m->jnt_type[j] == mjJNT_FREE) r->free_bodies_.push_back(m->jnt_bodyid[j]);
+  }
+  for (int k = 0; k < TetherCount(m); ++k) {
+    for (int end = 0; end < 2; ++end) {
+      const int b = EndBody(m, k, end);
+      if (b > 0 && r->body_radius_[b] > 0 &&
+          std::find(r->free_bodies_.begin(), r->free_bodies_.end(), b) == r->free_bodies_.end()) {
+        r->free_bodies_.push_back(b);
+      }
+    }
   }
 
   // Fixed follow distance (--distance, and the fallback): the longest tether in view.

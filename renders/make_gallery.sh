@@ -48,3 +48,11 @@ $M render models/workclass_rov_tms.xml --duration 300 --fps 1 --speedup 15 --siz
   --video $R/workclass_rov_tms.mp4 --png-every 100 $R/workclass_rov_tms
 $M plot models/workclass_rov_tms.xml --duration 300 --every 0.5 \
   --out $R/workclass_rov_tms_plot.png
+
+# Work-class ROV leaving its TMS with a constant-tension winch (docs/winch.md): 200 s as a
+# 20 s time-lapse; the plot (tensions, deployed length, payout speed, depth) from the run's log.
+$M render models/workclass_rov_tms_winch.xml --duration 200 --fps 1 --speedup 10 --size 640x360 \
+  --video $R/workclass_rov_tms_winch.mp4 --png-every 50 $R/workclass_rov_tms_winch
+$M run models/workclass_rov_tms_winch.xml --duration 200 --log $R/workclass_rov_tms_winch.csv
+$M plot $R/workclass_rov_tms_winch.csv --out $R/workclass_rov_tms_winch_plot.png
+rm $R/workclass_rov_tms_winch.csv

@@ -179,7 +179,7 @@ void Tether::AddDrag(ConstNodes x, ConstNodes v, ConstNodes q, const double* l, 
   const bool profile = current && !env_.water.profile.empty();
   const Vec3 u0 = current ? env_.water.current : Vec3::Zero();
   for (int i = 0; i <= N_; ++i) {
-    const double li = 0.5 * ((i > 0 ? l[i - 1] : 0) + (i < N_ ? l[i] : 0));
+    const double li = DragLength(i, l);
     const Vec3 u = profile ? env_.water.profile.At(x(2, i)) : u0;
     const Vec3 vr = u - v.col(i);
     const Vec3 qi = q.col(i);

@@ -294,7 +294,7 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
       const bool profile = current && !env_.water.profile.empty();
       const Vec3 u0 = current ? env_.water.current : Vec3::Zero();
       for (int i = 1; i <= nu; ++i) {
-        const double li = 0.5 * (w.l[i - 1] + (i < N_ ? w.l[i] : 0));
+        const double li = DragLength(i, w.l);
         const Vec3 u = profile ? env_.water.profile.At(xk(2, i)) : u0;
         const Vec3 qi = q.col(i);
         const Vec3 vr = u - vk.col(i);

@@ -289,6 +289,19 @@ class Tether {
   double Share(int i) const { return i < head_ ? head_share_[i] : share_[i]; }
   Vec3 Weight(int i) const { return i < head_ ? head_weight_[i] : Vec3(weight_ + 3 * i); }
   ConstNodes WeightMatrix() const { return ConstNodes(weight_, 3, N_ + 1); }
+  // Stretched length over which node i collects the distributed drag [m]: half of each
+  // adjacent segment (l the stretched segment lengths). In a Deployed view (winch), the
+  // drum-exit node takes the fraction L0/r of the winch segment and node 1 the rest, as for
+  // the weight (Tether::Deployed): node 1's share is about r - L0/2, 0 when it is inserted and
+  // when it is removed, so the loads at the drum are continuous across re-discretisations.
+  double DragLength(int i, const double* l) const {
+    const double a = i > 0 ? l[i - 1] : 0, b = i < N_ ? l[i] : 0;
+    if (head_ && N_ >= 2 && i < 2) {
+      const double c = L0_ / rest_;
+      return i == 0 ? c * b : std::max(0.0, (1 - c) * a + 0.5 * b);
+    }
+    return 0.5 * (a + b);
+  }
   // The winch segment's rest length at the instant of `e` [m] (a Deployed view).
   double WinchRest(const Ends& e) const { return e.rest > 0 ? e.rest : rest_; }
   // Galerkin curvature weight at interior node i: the mean of its two segments' rest lengths.

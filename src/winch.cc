@@ -29,9 +29,17 @@ Tether Tether::Deployed(int first, double rest, double speed) const {
   d.speed_ = speed;
   d.p_.segments = d.N_;
   d.p_.length = (d.N_ - 1) * L0_ + rest;
-  // Nodes 0 and 1 lump half the winch segment each, node 1 also half the next segment (if any).
+  // Masses: nodes 0 and 1 lump half the winch segment each, node 1 also half the next segment
+  // (if any). Loads (weight, buoyancy; drag in DragLength): the drum-exit node takes L0 of the
+  // winch segment, node 1 the rest, r - L0/2 with its half of the next segment. The totals are
+  // the same (r + L0/2), but node 1's load is then 0 when it is inserted (r = 0.5 L0 after the
+  // insertion) and when it is removed, and node 0's is L0 throughout: the loads at the drum are
+  // continuous across re-discretisations, so an inserted node, placed on the straight winch
+  // segment, is in equilibrium and the drum force does not ring (docs/winch.md). With node 1
+  // the far end (one segment), the plain halves.
   const double rho = env_.wet ? env_.water.density : 0;
   const double share[2] = {0.5 * rest, 0.5 * rest + (d.N_ >= 2 ? 0.5 * L0_ : 0)};
+  const double load[2] = {d.N_ >= 2 ? L0_ : share[0], d.N_ >= 2 ? rest - 0.5 * L0_ : share[1]};
   for (int i = 0; i < 2; ++i) {
     const double m = p_.mass_per_length * share[i];
     const double ma = Has(kAddedMass) ? p_.Can * rho * area_ * share[i] : 0;
@@ -41,8 +49,8 @@ Tether Tether::Deployed(int first, double rest, double speed) const {
     d.head_inv_mass_[i] = 1 / m;
     d.head_inv_mass_normal_[i] = 1 / (m + ma);
     double w = 0;
-    if (Has(kWeight)) w += m;
-    if (Has(kBuoyancy)) w -= rho * area_ * share[i];
+    if (Has(kWeight)) w += p_.mass_per_length * load[i];
+    if (Has(kBuoyancy)) w -= rho * area_ * load[i];
     d.head_weight_[i] = w * env_.gravity;
   }
   return d;
@@ -80,22 +88,11 @@ int Tether::Regrid(double* xp, double* vp, const Ends& e, Payout* p) const {
     const Vec3 ue = exit_velocity(f + 1, r);
     const double a = L0_ / r;
     const Vec3 x1 = x.col(f + 1), v1 = v.col(f + 1);
-    // Position: along the chord, where the new node is in axial equilibrium under its own net
-    // weight W (share r/2): EA (l_u/r_u - 1) - EA (l_l/L0 - 1) = W.t with l_u + l_l = l. The
-    // lumped weight it takes over was carried by the drum directly; at the plain fraction
-    // L0/r it would sag for a step (a dip of W in the drum's tension, 0.8% in the test).
-    // For a straight hanging line this is the exact static split (docs/winch.md); slack or
-    // without weight, the plain fraction.
-    double frac = a;  // of the chord, from node first+1 towards the drum
+    // Position: the plain fraction of the chord. Both new segments have the winch segment's
+    // strain, and the new node's load is 0 (Deployed: node 1's load r - L0/2 at r = 0.5 L0), so
+    // it is in equilibrium on the straight segment and no force changes.
     const Vec3 chord = d - x1;
-    const double l = chord.norm();
-    if (Has(kAxial) && l > r && N_ >= 2) {
-      const Vec3 t = -chord / l;  // from the drum towards node first+1
-      const double g = Vec3(weight_ + 3).dot(t) * (0.5 * r / L0_);  // [N] W.t, share r/2
-      const double ru = r - L0_;
-      const double lu = (g / p_.EA + l / L0_) / (1 / ru + 1 / L0_);
-      if (lu > ru && l - lu > L0_) frac = (l - lu) / l;
-    }
+    const double frac = a;  // of the chord, from node first+1 towards the drum
     x.col(f) = x1 + frac * chord;
     v.col(f) = v1 + a * (ue - v1);
     x.col(f - 1) = d;
