@@ -248,6 +248,32 @@ TEST_F(MuJoCoTest, MocapEndVelocityIsSecondOrder) {
   EXPECT_NEAR(std::log2(e1 / e2), 2, 0.3);
 }
 
+// A mocap end moved by a `motion:` declaration gets the motion's exact velocity, not a finite
+// difference of its positions (docs/reference.md, "Prescribed motion"). The three-point
+// difference would be off by A w^3 h^2 / 3 = 4e-5 m/s here (A = 1 m, w = pi rad/s, h = 2 ms),
+// and at the first two steps by O(A w) (no history yet); the exact derivative pi cos(pi t),
+// evaluated in double, leaves only rounding (1e-9 m/s is 1e5 times below the difference's
+// error and far above rounding on a velocity of order 3 m/s).
+TEST_F(MuJoCoTest, MotionEndGetsTheExactPrescribedVelocity) {
+  mjModel* m = Load(R"(<mujoco><option timestep="0.002" gravity="0 0 0"/><custom>
+      <text name="tether:t" data="ends=anchor,end length=10 segments=10 diameter=0.02
+            mass_per_length=0.3 EA=1e4 integrator=implicit"/>
+      <text name="motion:ship" data="x=1,2,0 ramp=0"/></custom>
+      <worldbody><site name="anchor"/>
+        <body name="ship" mocap="true" pos="8 0 0"><site name="end"/></body>
+      </worldbody></mujoco>)");
+  mjData* d = Make(m);
+  const int N = GetTether(m, 0)->segments();
+  double worst = 0;
+  for (int k = 0; k < 1000; ++k) {
+    mjtether::Step(m, d);
+    const double t = TetherTime(m, d, 0);
+    worst = std::max(worst, std::abs(NodeVelocities(m, d, 0)[3 * N] - M_PI * std::cos(M_PI * t)));
+  }
+  std::printf("motion end velocity: largest error %.3g m/s over 2 s\n", worst);
+  EXPECT_LT(worst, 1e-9);
+}
+
 // MuJoCo's RK4 evaluates the passive force at t + h/2 and t + h with a mocap body still where
 // it was at t (mocap bodies move only between steps). A call that finds the mocap end where
 // the last call left it takes its velocity as zero, as the position says, rather than reading
