@@ -40,10 +40,10 @@ enum Slot : int {
   kPrevTime,  // [s] the tether's time one call before kTime (== kTime: none yet)
   kPrevPosA,  // position(3) of end A at kPrevTime (mocap velocity, second order)
   kPrevPosB = kPrevPosA + 3,
-  kContactImpulse = kPrevPosB + 3,      // [N s] (3) contact impulse on the tether, last advance
+  kContactImpulse = kPrevPosB + 3,  // [N s] (3) contact impulse on the tether, last advance
   kContactCount = kContactImpulse + 3,  // reactions stored below (contact effect)
-  kContactDropped,                      // candidates beyond capacity at the last advance
-  kContactEndA,  // [N] (3) contact force on end node A (passed to its site), last advance
+  kContactDropped,   // candidates beyond capacity at the last advance
+  kContactEndA,      // [N] (3) contact force on end node A (passed to its site), last advance
   kContactEndB = kContactEndA + 3,  // [N] (3) the same for end B
   kStartTime = kContactEndB + 3,    // [s] when the initial shape was last set
   kStartStrain,                     // [-] strain of the chord at that moment (0 when not stretched)
@@ -90,11 +90,11 @@ struct AttachedTether {
   CouplingLimit limit[2];  // the time-step advisor's figures at load time
   // A winch (winch:NAME, docs/winch.md) at internal end A (sites swapped when declared at B).
   bool winch = false;
-  bool swapped = false;  // the winch is at the declared end B
+  bool swapped = false;            // the winch is at the declared end B
   WinchParams winch_params;
-  int actuator = -1;          // whose ctrl commands it
-  double initial_length = 0;  // [m] deployed at the start (the tether's `length`)
-  int winch_offset = 0;       // start of the winch slots in userdata
+  int actuator = -1;               // whose ctrl commands it
+  double initial_length = 0;       // [m] deployed at the start (the tether's `length`)
+  int winch_offset = 0;            // start of the winch slots in userdata
 };
 
 // The deployed unstretched length [m]: the winch's, else the declared length.
@@ -124,8 +124,8 @@ int ContactWorkSize(const AttachedTether& at) {
 struct ModelTethers {
   std::string source;
   std::vector<AttachedTether> tethers;
-  int work_size = 0;                  // doubles of mjData stack the callback takes
-  int nuserdata = 0;                  // m->nuserdata after Attach, to catch a stale registration
+  int work_size = 0;  // doubles of mjData stack the callback takes
+  int nuserdata = 0;  // m->nuserdata after Attach, to catch a stale registration
   std::vector<std::string> warnings;  // time-step advisor (see Warnings in mjtether.h)
   Environment env;                    // gravity and water, for the divergence diagnosis
   int nv = 0;                         // m->nv: the coupling's Jacobian scratch is 6 nv doubles
@@ -299,7 +299,8 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
     u[kInitialized] = 1;
     u[kStartTime] = d->time;
     u[kStartStrain] =
-        free_end ? 0 : std::max(0.0, (now.b.pos - now.a.pos).norm() / DeployedLength(at, u) - 1);
+        free_end ? 0
+                 : std::max(0.0, (now.b.pos - now.a.pos).norm() / DeployedLength(at, u) - 1);
     u[kTime] = u[kPrevTime] = d->time;
     StoreEnd(now.a, u + kEndA);
     StoreEnd(now.b, u + kEndB);
@@ -473,12 +474,12 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
   u[kTensionA] = stored.tension_a;
   u[kTensionB] = stored.tension_b;
   if (at.body[0] > 0 && !at.mocap[0]) {
-    mj_applyFT(m, d, r.force_a.data(), r.torque_a.data(), d->site_xpos + 3 * at.site[0], at.body[0],
-               d->qfrc_passive);
+    mj_applyFT(m, d, r.force_a.data(), r.torque_a.data(), d->site_xpos + 3 * at.site[0],
+               at.body[0], d->qfrc_passive);
   }
   if (!free_end && at.body[1] > 0 && !at.mocap[1]) {
-    mj_applyFT(m, d, r.force_b.data(), r.torque_b.data(), d->site_xpos + 3 * at.site[1], at.body[1],
-               d->qfrc_passive);
+    mj_applyFT(m, d, r.force_b.data(), r.torque_b.data(), d->site_xpos + 3 * at.site[1],
+               at.body[1], d->qfrc_passive);
   }
 }
 
@@ -534,9 +535,8 @@ bool Advise(const Tether& t, double timestep, std::string* warning, std::string*
     if (h <= limit) return true;
     s << "integrator=" << name << ": the tether step " << h << " s ("
       << (p.substeps > 0 ? "substeps=" + std::to_string(p.substeps) : "max_step")
-      << ") exceeds the explicit stability limit " << limit
-      << " s; set substeps >= " << static_cast<long long>(std::ceil(timestep / limit))
-      << " or max_step <= " << limit
+      << ") exceeds the explicit stability limit " << limit << " s; set substeps >= "
+      << static_cast<long long>(std::ceil(timestep / limit)) << " or max_step <= " << limit
       << ", or remove both (automatic substeps), or use integrator=implicit";
     *warning = s.str();
     return true;
@@ -582,7 +582,7 @@ int FreeCarrier(const mjModel* m, int body) {
 //   several diameters (its minimum bend radius), so such nodes resolve nothing physical, and
 //   the lumped cylinder per node is wider than it is long (the hard-case suite checks d/5
 //   against Irvine's catenary; d/10 is the limit kept).
-constexpr double kMinDensity = 1.2;             // [kg/m^3] air
+constexpr double kMinDensity = 1.2;            // [kg/m^3] air
 constexpr double kMinSegmentPerDiameter = 0.1;  // [-] L0 / d
 // A start stretched beyond this strain is far from equilibrium: warned with its tension.
 constexpr double kStretchWarning = 1e-3;  // [-]
@@ -592,8 +592,8 @@ bool CheckParameters(const TetherParams& p, bool wet, std::string* error) {
   const double area = 3.14159265358979323846 * p.diameter * p.diameter / 4;
   const double density = p.mass_per_length / area;
   if (p.diameter > p.length) {
-    s << "key 'diameter' = " << p.diameter << " m is larger than the tether's length " << p.length
-      << " m: a lumped-mass line needs a slender tether (diameter in metres, not "
+    s << "key 'diameter' = " << p.diameter << " m is larger than the tether's length "
+      << p.length << " m: a lumped-mass line needs a slender tether (diameter in metres, not "
       << "millimetres?)";
   } else if (wet && density < kMinDensity) {
     s << "key 'diameter' = " << p.diameter << " m with mass_per_length = " << p.mass_per_length
@@ -616,8 +616,8 @@ bool CheckParameters(const TetherParams& p, bool wet, std::string* error) {
 // The positions of the ends at the start (qpos0, mocap bodies at their model positions):
 // refuses an end below the seabed or ends farther apart than length (1 + max_strain); warns
 // about a stretched start with the strain and the tension it means.
-bool CheckStart(const mjModel* m, const mjData* d, const Environment& env, const AttachedTether& at,
-                std::string* warning, std::string* error) {
+bool CheckStart(const mjModel* m, const mjData* d, const Environment& env,
+                const AttachedTether& at, std::string* warning, std::string* error) {
   TetherParams p = at.tether.params();
   if (at.winch) p.length = at.initial_length;
   const char* end_name[2] = {"A", "B"};
@@ -628,8 +628,8 @@ bool CheckStart(const mjModel* m, const mjData* d, const Environment& env, const
     const double z = xs[2], zb = env.water.SeabedHeight(xs[0], xs[1]);
     if (z < zb) {
       s << "end " << end_name[end] << " (site '" << mj_id2name(m, mjOBJ_SITE, at.site[end])
-        << "') starts at z = " << z << " m, " << zb - z << " m below the seabed (water key "
-        << SeabedDescription(env.water)
+        << "') starts at z = " << z << " m, " << zb - z
+        << " m below the seabed (water key " << SeabedDescription(env.water)
         << "): move the site or its body above the seabed, or lower the seabed";
       *error = s.str();
       return false;
@@ -648,10 +648,9 @@ bool CheckStart(const mjModel* m, const mjData* d, const Environment& env, const
   if (strain > p.max_strain) {
     s << "key 'length' = " << p.length << " m: the ends (sites '"
       << mj_id2name(m, mjOBJ_SITE, at.site[0]) << "', '" << mj_id2name(m, mjOBJ_SITE, at.site[1])
-      << "') start " << span
-      << " m apart, more than length x (1 + max_strain) = " << p.length * (1 + p.max_strain)
-      << " m: the tether cannot start; make it at least " << span
-      << " m long or move the sites closer";
+      << "') start " << span << " m apart, more than length x (1 + max_strain) = "
+      << p.length * (1 + p.max_strain) << " m: the tether cannot start; make it at least "
+      << span << " m long or move the sites closer";
     *error = s.str();
     return false;
   }
@@ -667,8 +666,8 @@ bool CheckStart(const mjModel* m, const mjData* d, const Environment& env, const
 }
 
 // Vehicles (vehicle:BODY texts) whose body starts below the seabed.
-bool CheckVehicles(const mjModel* m, const mjData* d, const Environment& env, std::string* element,
-                   std::string* error) {
+bool CheckVehicles(const mjModel* m, const mjData* d, const Environment& env,
+                   std::string* element, std::string* error) {
   if (!env.water.has_seabed) return true;
   for (int i = 0; i < m->ntext; ++i) {
     const std::string name = TextName(m, i);
@@ -760,9 +759,8 @@ std::string Diagnose(const mjModel* m, const mjData* d, const Environment& env,
     }
     for (int end = 0; end < 2; ++end) {
       if (at.body[end] > 0 && !at.mocap[end]) {
-        s << ", by forces on body '" << body_name(end)
-          << "' larger than EA x max_strain = " << holds
-          << " N; lengthen the tether or reduce them";
+        s << ", by forces on body '" << body_name(end) << "' larger than EA x max_strain = "
+          << holds << " N; lengthen the tether or reduce them";
         return s.str();
       }
     }
@@ -789,8 +787,8 @@ std::string Diagnose(const mjModel* m, const mjData* d, const Environment& env,
     for (int end = 0; end < (both ? 2 : 1); ++end) {
       const double zb = env.water.SeabedHeight(pos[end].x(), pos[end].y());
       if (pos[end].z() < zb) {
-        s << "seabed penetration: end " << end_name[end] << " (body '" << body_name(end) << "') is "
-          << zb - pos[end].z() << " m below the seabed (z = " << zb
+        s << "seabed penetration: end " << end_name[end] << " (body '" << body_name(end)
+          << "') is " << zb - pos[end].z() << " m below the seabed (z = " << zb
           << " m), pressing the tether into it; keep the body above the seabed";
         return s.str();
       }
@@ -871,7 +869,7 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
       c.m_eff = 1 / lambda;
       c.omega = std::sqrt(c.k_end * lambda);
       c.omega_h = c.omega * h;
-      c.limit = p.integrator == Integrator::kRK4         ? kCouplingLimitRk4
+      c.limit = p.integrator == Integrator::kRK4        ? kCouplingLimitRk4
                 : p.integrator == Integrator::kExplicit  ? kCouplingLimitExplicit
                 : p.integrator == Integrator::kImplicit2 ? kCouplingLimitImplicit2
                                                          : 0;
@@ -887,7 +885,8 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
                 ? "; use integrator=implicit (measured within 1% at omega h 10.6), or <option "
                 : "; use integrator=implicit (stable at any omega h measured) or implicit2 (up "
                   "to omega h 4), or <option ")
-        << "timestep> <= " << c.limit / c.omega << " s, or fewer segments or a smaller EA";
+        << "timestep> <= "
+        << c.limit / c.omega << " s, or fewer segments or a smaller EA";
       if (c.omega_h >= c.limit) {
         *error = where + s.str();
         ok = false;
@@ -958,8 +957,7 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
     if (mj_name2id(m, mjOBJ_ACTUATOR, w->actuator.c_str()) < 0) {
       return fail(name, "key 'actuator': no actuator named '" + w->actuator +
                             "' in the model (its ctrl commands the winch; declare one, e.g. "
-                            "<general name=\"" +
-                            w->actuator + "\" joint=... gear=\"0\"/>)");
+                            "<general name=\"" + w->actuator + "\" joint=... gear=\"0\"/>)");
     }
     winches[tether] = {name, *w};
   }
@@ -991,10 +989,8 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
                                "' is free; the winch's end must be attached (end=A)");
       }
       if (p.effects & kContact) {
-        return fail(wname,
-                    "a winch with the contact effect is not supported yet; remove "
-                    "contact= from <text name=\"" +
-                        name + "\">");
+        return fail(wname, "a winch with the contact effect is not supported yet; remove "
+                           "contact= from <text name=\"" + name + "\">");
       }
       if (!(p.length >= w.min_length && p.length <= w.max_length)) {
         s << "key 'min_length'/'max_length': the tether's length " << p.length
@@ -1003,24 +999,23 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
         return fail(wname, s.str());
       }
       if (!(w.min_length >= L0)) {
-        s << "key 'min_length' = " << w.min_length << " m is shorter than one segment, " << L0
-          << " m (length / segments of the tether); allowed: [" << L0 << ", " << w.max_length
-          << "] m";
+        s << "key 'min_length' = " << w.min_length << " m is shorter than one segment, "
+          << L0 << " m (length / segments of the tether); allowed: [" << L0 << ", "
+          << w.max_length << "] m";
         return fail(wname, s.str());
       }
       const double nmax = std::floor(w.max_length / L0 + 0.5) + 2;
       if (!(nmax <= 1e5)) {
-        s << "key 'max_length' = " << w.max_length << " m needs " << nmax << " segments of " << L0
-          << " m, more than 100000; allowed: [" << w.min_length << ", " << 1e5 * L0
-          << "] m, or longer segments";
+        s << "key 'max_length' = " << w.max_length << " m needs " << nmax
+          << " segments of " << L0 << " m, more than 100000; allowed: [" << w.min_length
+          << ", " << 1e5 * L0 << "] m, or longer segments";
         return fail(wname, s.str());
       }
       // At most one node inserted or removed per tether step (Tether::Advance).
       if (!(w.max_speed * m->opt.timestep <= 0.25 * L0)) {
         s << "key 'max_speed' = " << w.max_speed << " m/s pays out "
-          << w.max_speed * m->opt.timestep << " m per <option timestep> " << m->opt.timestep
-          << " s, more than a quarter segment (" << 0.25 * L0 << " m); allowed: (0, "
-          << 0.25 * L0 / m->opt.timestep << "] m/s";
+          << w.max_speed * m->opt.timestep << " m per <option timestep> " << m->opt.timestep << " s, more than a quarter segment ("
+          << 0.25 * L0 << " m); allowed: (0, " << 0.25 * L0 / m->opt.timestep << "] m/s";
         return fail(wname, s.str());
       }
       initial_length = p.length;
@@ -1103,7 +1098,8 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
     at.offset = offset;
     at.winch_offset = offset + static_cast<int>(block) - (at.winch ? kWinchSlots : 0);
     offset += static_cast<int>(block);
-    set->work_size = std::max(set->work_size, tether->WorkspaceSize() + ContactWorkSize(at));
+    set->work_size =
+        std::max(set->work_size, tether->WorkspaceSize() + ContactWorkSize(at));
     set->tethers.push_back(std::move(at));
   }
   // Start-up checks on the geometry at qpos0 (a scratch mjData, kinematics only).
@@ -1175,7 +1171,8 @@ mjModel* LoadModel(const std::string& path, std::string* error) {
   return m;
 }
 
-mjModel* LoadModelFromString(const std::string& xml, const std::string& name, std::string* error) {
+mjModel* LoadModelFromString(const std::string& xml, const std::string& name,
+                             std::string* error) {
   if (!mju_user_error) mju_user_error = DefaultError;
   auto vfs = std::make_unique<mjVFS>();  // about 2 MB: not on the stack
   mj_defaultVFS(vfs.get());
@@ -1397,12 +1394,13 @@ std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d) {
       s << "Most likely cause: " << cause << ".";
     } else if (IsExplicit(t.params().integrator)) {
       s << "The " << IntegratorName(t.params().integrator) << " integrator's stable step is "
-        << t.ExplicitStableStep() << " s; use integrator=implicit, or fewer segments (now "
-        << t.segments() << "), or a smaller <option timestep> (now " << m->opt.timestep << " s).";
+        << t.ExplicitStableStep()
+        << " s; use integrator=implicit, or fewer segments (now " << t.segments()
+        << "), or a smaller <option timestep> (now " << m->opt.timestep << " s).";
     } else {
       s << "Reduce <option timestep> (now " << m->opt.timestep
-        << " s) or set max_step for tether substeps, or use fewer segments (now " << t.segments()
-        << ").";
+        << " s) or set max_step for tether substeps, or use fewer segments (now "
+        << t.segments() << ").";
     }
     return s.str();
   }

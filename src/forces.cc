@@ -1,8 +1,9 @@
+#include "tether.h"
+
 #include <algorithm>
 #include <cmath>
 
 #include "detail/work.h"
-#include "tether.h"
 
 namespace mjtether {
 using namespace detail;
@@ -45,7 +46,8 @@ void Tether::SegmentGeometry(ConstNodes x, Nodes t, double* l) const {
 // eps/engage_h in magnitude. The instantaneous law would jump from 0 to damping deps/dt as l
 // crosses L0, and the step's equations would then have no root (see ImplicitStep); this one
 // is continuous in l and converges to the same law as the step shrinks.
-inline double Tether::AxialForce(double eps, const Vec3& t, const Vec3& dv, double engage_h) const {
+inline double Tether::AxialForce(double eps, const Vec3& t, const Vec3& dv,
+                                 double engage_h) const {
   const bool taut = eps > 0;
   if (!taut && !(eps < 0 && Has(kCompression))) return 0;
   double T = (taut ? p_.EA : p_.EAc) * eps;
@@ -60,8 +62,8 @@ inline double Tether::AxialForce(double eps, const Vec3& t, const Vec3& dv, doub
   return taut ? std::max(T, 0.0) : std::min(T, 0.0);
 }
 
-void Tether::AddAxial(ConstNodes x, ConstNodes v, ConstNodes t, const double* l, double* T, Nodes f,
-                      const Start* start, double rest0) const {
+void Tether::AddAxial(ConstNodes x, ConstNodes v, ConstNodes t, const double* l, double* T,
+                      Nodes f, const Start* start, double rest0) const {
   (void)x;
   const double inv_L0 = 1 / L0_;  // [1/m]
   const double L0sq = L0_ * L0_;
@@ -216,10 +218,10 @@ void Tether::AddSeabed(ConstNodes x, ConstNodes v, ConstNodes q, Nodes f,
     const Vec3 vh(v(0, i), v(1, i), 0);
     const Vec3 va = vh.dot(qh) * qh, vc = vh - va;
     const double eps = w.seabed_friction_speed;
-    if (va.norm() > 0)
-      f.col(i) -= w.seabed_friction_axial * N * std::tanh(va.norm() / eps) * va.normalized();
-    if (vc.norm() > 0)
-      f.col(i) -= w.seabed_friction * N * std::tanh(vc.norm() / eps) * vc.normalized();
+    if (va.norm() > 0) f.col(i) -= w.seabed_friction_axial * N * std::tanh(va.norm() / eps) *
+                                    va.normalized();
+    if (vc.norm() > 0) f.col(i) -= w.seabed_friction * N * std::tanh(vc.norm() / eps) *
+                                   vc.normalized();
   }
 }
 

@@ -1,8 +1,9 @@
+#include "tether.h"
+
 #include <algorithm>
 #include <cmath>
 
 #include "detail/work.h"
-#include "tether.h"
 
 namespace mjtether {
 using namespace detail;
@@ -17,7 +18,8 @@ EndState Interpolate(const EndState& e0, const EndState& e1, double dt, double s
   const double d01 = -6 * s2 + 6 * s, d11 = 3 * s2 - 2 * s;
   EndState e;
   e.pos = h00 * e0.pos + h10 * dt * e0.vel + h01 * e1.pos + h11 * dt * e1.vel;
-  e.vel = dt > 0 ? ((d00 * e0.pos + d01 * e1.pos) / dt + d10 * e0.vel + d11 * e1.vel) : e1.vel;
+  e.vel = dt > 0 ? ((d00 * e0.pos + d01 * e1.pos) / dt + d10 * e0.vel + d11 * e1.vel)
+                 : e1.vel;
   Vec3 axis = (1 - s) * e0.axis + s * e1.axis;
   e.axis = axis.norm() > 0 ? Vec3(axis.normalized()) : e1.axis;
   return e;
@@ -320,7 +322,8 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         BlockBand::Block d = A.D(i - 1);
         const Mat3 nn = n * n.transpose();
         d += (h2 * seabed_k_ * Share(i) + h * seabed_c_ * Share(i)) * nn;
-        const double N = std::max(0.0, Share(i) * (seabed_k_ * pen - seabed_c_ * vk.col(i).dot(n)));
+        const double N =
+            std::max(0.0, Share(i) * (seabed_k_ * pen - seabed_c_ * vk.col(i).dot(n)));
         const double mu = std::max(wt.seabed_friction, wt.seabed_friction_axial);
         const double vh = (vk.col(i) - vk.col(i).dot(n) * n).norm();
         const double eps = wt.seabed_friction_speed;
@@ -542,8 +545,8 @@ void Tether::ImplicitStepAdaptive(Nodes x, Nodes v, const Ends& now, const Ends&
 // w by about w h/2 per radian, which at the vehicle's step is as much as the tether's own
 // damping of its first axial modes; this scheme's error is O(h^2) and its damping O((w h)^3),
 // and it still removes the unresolved axial modes (L-stable).
-void Tether::Sdirk2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h, double* work,
-                        StepStatus* stats) const {
+void Tether::Sdirk2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
+                        double* work, StepStatus* stats) const {
   constexpr double kGamma = 0.29289321881345247560;  // 1 - 1/sqrt(2)
   Work w(work, N_);
   const int n = N_ + 1;

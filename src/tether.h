@@ -17,10 +17,11 @@
 #ifndef MJTETHER_SRC_TETHER_H_
 #define MJTETHER_SRC_TETHER_H_
 
-#include <Eigen/Core>
 #include <memory>
 #include <optional>
 #include <string>
+
+#include <Eigen/Core>
 
 #include "contact.h"
 #include "params.h"
@@ -33,8 +34,8 @@ using ConstNodes = Eigen::Map<const Eigen::Matrix3Xd>;  // 3 x n
 
 // The kinematics of one attached end at one instant.
 struct EndState {
-  Vec3 pos = Vec3::Zero();    // [m] site position, world frame
-  Vec3 vel = Vec3::Zero();    // [m/s] site velocity, world frame
+  Vec3 pos = Vec3::Zero();   // [m] site position, world frame
+  Vec3 vel = Vec3::Zero();   // [m/s] site velocity, world frame
   Vec3 axis = Vec3::UnitX();  // [-] site x-axis (clamp direction, pointing into the tether)
 };
 
@@ -74,8 +75,8 @@ struct EndReactions {
 // Outcome of Advance: ok, or where the state stopped making sense.
 struct StepStatus {
   bool ok = true;
-  int node = -1;       // first offending node
-  std::string reason;  // "non-finite position", "strain 1.3 > max_strain 1", ...
+  int node = -1;         // first offending node
+  std::string reason;    // "non-finite position", "strain 1.3 > max_strain 1", ...
   // How the implicit schemes' Newton iterations went over this Advance (zero otherwise).
   int newton_iterations = 0;  // linear solves, over all steps and stages
   int halvings = 0;           // steps (or half steps) redone as two halves
@@ -151,7 +152,8 @@ class Tether {
 
   // Forces and moments on the sites, with the end nodes placed at the sites given (so a
   // caller can evaluate the reaction at an intermediate state of its own integrator).
-  EndReactions Reactions(const double* x, const double* v, const Ends& ends, double* work) const;
+  EndReactions Reactions(const double* x, const double* v, const Ends& ends,
+                         double* work) const;
 
   // Segment tensions T (N) [N] of the state as it is, >= 0 (slack or compressed: 0).
   void Tensions(const double* x, const double* v, double* T) const;
@@ -193,8 +195,8 @@ class Tether {
   // The start of an implicit step of length h [s] (state x at its start): segments and seabed
   // contacts that engage within the step take the engaged damping law (see AxialForce).
   struct Start {
-    ConstNodes x;   // 3 x n
-    double h;       // [s]
+    ConstNodes x;  // 3 x n
+    double h;      // [s]
     bool discrete;  // damping on the backward difference of the strain over the step
                     // (the Newton iterations past the first, see ImplicitStep)
   };
@@ -204,8 +206,8 @@ class Tether {
   // Per-effect terms; each adds to f (3 x n). See tether.cc for the equations.
   void SegmentGeometry(ConstNodes x, Nodes t, double* l) const;
   double AxialForce(double eps, const Vec3& t, const Vec3& dv, double engage_h) const;
-  void AddAxial(ConstNodes x, ConstNodes v, ConstNodes t, const double* l, double* T, Nodes f,
-                const Start* start, double rest0) const;
+  void AddAxial(ConstNodes x, ConstNodes v, ConstNodes t, const double* l, double* T,
+                Nodes f, const Start* start, double rest0) const;
   void BendingMoments(ConstNodes t, const Ends& ends, Nodes M) const;
   void AddBending(ConstNodes t, const double* l, ConstNodes M, Nodes f) const;
   void NodeTangents(ConstNodes x, ConstNodes t, Nodes q) const;
@@ -236,15 +238,16 @@ class Tether {
   Vec3 Acceleration(int i, const Vec3& fi, const Vec3& qi) const;
   void ExplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
                     double* work) const;
-  void Rk4Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h, double* work) const;
-  bool ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h, double* work,
-                    StepStatus* stats) const;
+  void Rk4Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
+               double* work) const;
+  bool ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
+                    double* work, StepStatus* stats) const;
   void ImplicitStepAdaptive(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
                             int depth, double* work, StepStatus* stats,
                             double impulse_weight = 1) const;
 
-  void Sdirk2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h, double* work,
-                  StepStatus* stats) const;
+  void Sdirk2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
+                  double* work, StepStatus* stats) const;
 
   bool Has(unsigned effect) const { return (p_.effects & effect) != 0; }
   bool Dynamic(int i) const { return i > 0 && (i < N_ || p_.free_end); }
@@ -252,13 +255,13 @@ class Tether {
   TetherParams p_;
   Environment env_;
   int N_ = 0;
-  double L0_ = 0;                         // [m] rest length of a segment
-  double area_ = 0;                       // [m^2] pi d^2 / 4
-  double kn_ = 0, kt_ = 0;                // [kg/m^2] 1/2 rho Cdn d, 1/2 rho Cdt pi d (per length)
-  double seabed_k_ = 0, seabed_c_ = 0;    // [N/m^2], [N s/m^2] per length
+  double L0_ = 0;               // [m] rest length of a segment
+  double area_ = 0;             // [m^2] pi d^2 / 4
+  double kn_ = 0, kt_ = 0;      // [kg/m^2] 1/2 rho Cdn d, 1/2 rho Cdt pi d (per length)
+  double seabed_k_ = 0, seabed_c_ = 0;  // [N/m^2], [N s/m^2] per length
   double contact_k_ = 0, contact_c_ = 0;  // [N/m^2], [N s/m^2] per length
-  double explicit_limit_ = 0;             // [s]
-  double explicit_dt_ = 0;                // [s]
+  double explicit_limit_ = 0;   // [s]
+  double explicit_dt_ = 0;      // [s]
   StabilityTerms terms_;
   double damping_per_L0_ = 0;  // [N s/m] internal damping / rest segment length
   // Per-node arrays, owned by the tether and shared (not copied) by its Deployed views, which
@@ -298,7 +301,9 @@ class Tether {
   // The winch segment's rest length at the instant of `e` [m] (a Deployed view).
   double WinchRest(const Ends& e) const { return e.rest > 0 ? e.rest : rest_; }
   // Galerkin curvature weight at interior node i: the mean of its two segments' rest lengths.
-  double CurvatureWeight(int i) const { return i == 1 && head_ ? 0.5 * (rest_ + L0_) : L0_; }
+  double CurvatureWeight(int i) const {
+    return i == 1 && head_ ? 0.5 * (rest_ + L0_) : L0_;
+  }
   // One tether step of the configured integrator (the body of Advance's loop).
   void Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h, double* work,
             StepStatus* status) const;

@@ -39,8 +39,8 @@ void SetNodes(const mjModel* m, const mjData* d, const Eigen::Matrix3Xd& x) {
 // lengthens the wrap by ~0.6 mm, the stretch T/EA L ~0.4 mm, the penalty's sink ~0.3 mm),
 // x_B within 2 mm (the polygon's nodes stand 0.6 mm off the circle), T_A within 1 % (its
 // difference from M g, w (z_A - z_B) = 2.5 N, is 5 % of it: a drum passing friction, or the
-// weight left out, fails). Site A is in a body of its own: on the world body, the drum (also
-// the world's) would count as end A's own geom and be skipped near A (docs/contact.md).
+// weight left out, fails). Site A is in a body of its own (on the world body it would do as
+// well: the drum is 2 m from it, not end A's own geom, docs/contact.md).
 class Drape : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(Drape, EquilibriumAsStaticsPredicts) {
