@@ -29,7 +29,8 @@ constexpr int kGoldenIterations = 40;
 
 bool Supported(int type) {
   return type == mjGEOM_PLANE || type == mjGEOM_SPHERE || type == mjGEOM_CAPSULE ||
-         type == mjGEOM_CYLINDER || type == mjGEOM_BOX || type == mjGEOM_ELLIPSOID;
+         type == mjGEOM_CYLINDER || type == mjGEOM_BOX || type == mjGEOM_ELLIPSOID ||
+         type == mjGEOM_MESH;
 }
 
 const char* TypeName(int type) {
@@ -43,9 +44,51 @@ const char* TypeName(int type) {
   }
 }
 
-// Signed distance of the local point p to a box, cylinder or ellipsoid of MuJoCo size `sz`
-// (box: half sizes; cylinder: radius, half length along z; ellipsoid: semi-axes).
-double SignedDistance(int type, const double* sz, const Vec3& p) {
+// Closest point to p on the triangle (a, b, c) (Ericson, Real-Time Collision Detection, 2005,
+// section 5.1.5: by the Voronoi regions of its corners, edges and face).
+Vec3 ClosestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + (d1 / (d1 - d3)) * ab;
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + (d2 / (d2 - d6)) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
+  }
+  const double denom = 1 / (va + vb + vc);
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+// Signed distance of the local point p to a convex hull: inside, minus the distance to the
+// nearest face plane (max of n.p - o, exact inside a convex body); outside, the distance to
+// the nearest triangle that faces p (the closest point of a convex body is on one of them).
+double HullDistance(const ConvexHull& h, const Vec3& p) {
+  double inside = -INFINITY;
+  const int n = static_cast<int>(h.normal.size());
+  for (int f = 0; f < n; ++f) inside = std::max(inside, h.normal[f].dot(p) - h.offset[f]);
+  if (inside <= 0) return inside;
+  double best = INFINITY;
+  for (int f = 0; f < n; ++f) {
+    if (h.normal[f].dot(p) - h.offset[f] <= 0) continue;
+    const Vec3 q = ClosestOnTriangle(p, h.corner[3 * f], h.corner[3 * f + 1], h.corner[3 * f + 2]);
+    best = std::min(best, (p - q).squaredNorm());
+  }
+  return std::sqrt(best);
+}
+
+// Signed distance of the local point p to a box, cylinder, ellipsoid or mesh (hull) of MuJoCo
+// size `sz` (box: half sizes; cylinder: radius, half length along z; ellipsoid: semi-axes).
+double SignedDistance(int type, const double* sz, const ConvexHull* hull, const Vec3& p) {
+  if (type == mjGEOM_MESH) return HullDistance(*hull, p);
   if (type == mjGEOM_BOX) {
     const Vec3 q = p.cwiseAbs() - Vec3(sz[0], sz[1], sz[2]);
     return q.cwiseMax(0.0).norm() + std::min(q.maxCoeff(), 0.0);
@@ -62,19 +105,35 @@ double SignedDistance(int type, const double* sz, const Vec3& p) {
   return k0 * (k0 - 1) / k1;
 }
 
-// Outward unit normal of a box, cylinder or ellipsoid at local p: the gradient of the signed
-// distance by central differences (step small against the geom).
-Vec3 Normal(int type, const double* sz, const Vec3& p) {
-  const double e = 1e-7 * std::max({sz[0], sz[1], type == mjGEOM_CYLINDER ? sz[0] : sz[2]});
+// Outward unit normal of a box, cylinder, ellipsoid or mesh at local p: the gradient of the
+// signed distance by central differences (step small against the geom).
+Vec3 Normal(int type, const double* sz, const ConvexHull* hull, const Vec3& p) {
+  const double e = 1e-7 * (type == mjGEOM_MESH
+                               ? hull->scale
+                               : std::max({sz[0], sz[1], type == mjGEOM_CYLINDER ? sz[0] : sz[2]}));
   Vec3 g;
   for (int k = 0; k < 3; ++k) {
     Vec3 a = p, b = p;
     a[k] += e;
     b[k] -= e;
-    g[k] = SignedDistance(type, sz, a) - SignedDistance(type, sz, b);
+    g[k] = SignedDistance(type, sz, hull, a) - SignedDistance(type, sz, hull, b);
   }
   const double n = g.norm();
   return n > 0 ? Vec3(g / n) : Vec3::UnitZ();
+}
+
+// Signed distance of the local point p to any supported geom (plane: its side z).
+double PointDistance(int type, const double* sz, const ConvexHull* hull, const Vec3& p) {
+  switch (type) {
+    case mjGEOM_PLANE:
+      return p.z();
+    case mjGEOM_SPHERE:
+      return p.norm() - sz[0];
+    case mjGEOM_CAPSULE:
+      return Vec3(p.x(), p.y(), p.z() - std::clamp(p.z(), -sz[1], sz[1])).norm() - sz[0];
+    default:
+      return SignedDistance(type, sz, hull, p);
+  }
 }
 
 // Closest points of segments [a0, a1] and [b0, b1]: parameters s (on a), t (on b)
@@ -119,7 +178,8 @@ struct Closest {
   Vec3 normal, surface;
 };
 
-Closest SegmentGeom(int type, const double* sz, const Vec3& a, const Vec3& b) {
+Closest SegmentGeom(int type, const double* sz, const ConvexHull* hull, const Vec3& a,
+                    const Vec3& b) {
   Closest c;
   auto from_center = [&](const Vec3& q, const Vec3& center, double radius) {
     const Vec3 r = q - center;
@@ -152,9 +212,9 @@ Closest SegmentGeom(int type, const double* sz, const Vec3& a, const Vec3& b) {
     from_center(a + c.s * (b - a), b0 + t * (b1 - b0), sz[0]);
     return c;
   }
-  // Box, cylinder, ellipsoid: golden section on the signed distance along the segment.
+  // Box, cylinder, ellipsoid, mesh: golden section on the signed distance along the segment.
   constexpr double kInvPhi = 0.61803398874989484820;
-  auto f = [&](double s) { return SignedDistance(type, sz, a + s * (b - a)); };
+  auto f = [&](double s) { return SignedDistance(type, sz, hull, a + s * (b - a)); };
   double lo = 0, hi = 1;
   double x1 = hi - kInvPhi * (hi - lo), x2 = lo + kInvPhi * (hi - lo);
   double f1 = f(x1), f2 = f(x2);
@@ -182,9 +242,49 @@ Closest SegmentGeom(int type, const double* sz, const Vec3& a, const Vec3& b) {
   }
   const Vec3 q = a + c.s * (b - a);
   c.dist = best;
-  c.normal = Normal(type, sz, q);
+  c.normal = Normal(type, sz, hull, q);
   c.surface = q - best * c.normal;
   return c;
+}
+
+// The convex hull of mesh `mesh` in its geom's frame (MuJoCo stores a mesh's vertices in
+// the frame of its inertia, which is the geom's). Its triangles from the convex graph MuJoCo
+// keeps for collisions (mesh_graph: numvert, numface, vert_edgeadr[numvert],
+// vert_globalid[numvert], edge_localid[numvert + 3 numface], face_globalid[3 numface]), or,
+// for a mesh without one, the mesh's own triangles (taken as convex). Each plane is turned
+// outward: the vertices' centroid on its inner side.
+void MakeHull(const mjModel* m, int mesh, ConvexHull* h) {
+  const float* vert = m->mesh_vert + 3 * m->mesh_vertadr[mesh];
+  const int nv = m->mesh_vertnum[mesh];
+  const int* faces;
+  int nf;
+  if (m->mesh_graphadr[mesh] >= 0) {
+    const int* graph = m->mesh_graph + m->mesh_graphadr[mesh];
+    const int gv = graph[0];
+    nf = graph[1];
+    faces = graph + 2 + 3 * gv + 3 * nf;
+  } else {
+    nf = m->mesh_facenum[mesh];
+    faces = m->mesh_face + 3 * m->mesh_faceadr[mesh];
+  }
+  auto vertex = [&](int i) { return Vec3(vert[3 * i], vert[3 * i + 1], vert[3 * i + 2]); };
+  Vec3 centroid = Vec3::Zero();
+  for (int i = 0; i < nv; ++i) centroid += vertex(i);
+  centroid /= std::max(nv, 1);
+  double scale = 0;
+  for (int i = 0; i < nv; ++i) scale = std::max(scale, (vertex(i) - centroid).norm());
+  h->scale = scale > 0 ? scale : 1;
+  for (int f = 0; f < nf; ++f) {
+    const Vec3 a = vertex(faces[3 * f]), b = vertex(faces[3 * f + 1]), c = vertex(faces[3 * f + 2]);
+    Vec3 n = (b - a).cross(c - a);
+    // Degenerate triangles carry no plane.
+    if (!(n.norm() > 1e-12 * h->scale * h->scale)) continue;
+    n.normalize();
+    if (n.dot(centroid - a) > 0) n = -n;
+    h->corner.insert(h->corner.end(), {a, b, c});
+    h->normal.push_back(n);
+    h->offset.push_back(n.dot(a));
+  }
 }
 
 }  // namespace
@@ -221,7 +321,7 @@ bool ResolveContactGeoms(const mjModel* m, const std::string& spec, const int si
       if (g >= 0) {
         if (!Supported(m->geom_type[g])) {
           *error = "key 'contact': geom '" + name + "' is a " + TypeName(m->geom_type[g]) +
-                   "; supported: plane, sphere, capsule, cylinder, box, ellipsoid";
+                   "; supported: plane, sphere, capsule, cylinder, box, ellipsoid, mesh";
           return false;
         }
         geoms.push_back(g);
@@ -246,13 +346,23 @@ bool ResolveContactGeoms(const mjModel* m, const std::string& spec, const int si
   for (int g : geoms) {
     ContactGeom cg;
     cg.geom = g;
-    // A geom on an end's own body: skip it along the arc the tether needs to leave the geom's
-    // bounding sphere from the site (both fixed in the body frame).
+    if (m->geom_type[g] == mjGEOM_MESH) MakeHull(m, m->geom_dataid[g], &cg.hull);
+    // A geom on an end's body is that end's own when the site is inside it or within
+    // rho = L0 + d of its surface (the tether starts against it): its segments skip it over the
+    // arc that leaves it, the site's depth in it plus rho. Other geoms of that body (a part of
+    // the vehicle away from the attachment, scenery on the world body) are never skipped.
+    const double rho = tether.rest_segment_length() + tether.params().diameter;
     for (int end = 0; end < 2; ++end) {
       const int s = site[end];
       if (s < 0 || m->site_bodyid[s] != m->geom_bodyid[g]) continue;
-      const Vec3 d = Vec3(m->site_pos + 3 * s) - Vec3(m->geom_pos + 3 * g);
-      cg.skip[end] = m->geom_type[g] == mjGEOM_PLANE ? INFINITY : d.norm() + m->geom_rbound[g];
+      // The site in the geom's frame (both are fixed in the body's frame).
+      mjtNum rel[3], local[3], qinv[4];
+      mju_sub3(rel, m->site_pos + 3 * s, m->geom_pos + 3 * g);
+      mju_negQuat(qinv, m->geom_quat + 4 * g);
+      mju_rotVecQuat(local, rel, qinv);
+      const double depth = -PointDistance(m->geom_type[g], m->geom_size + 3 * g, &cg.hull,
+                                          Vec3(local[0], local[1], local[2]));
+      if (depth > -rho) cg.skip[end] = std::max(0.0, depth) + rho;
     }
     out->geoms.push_back(cg);
   }
@@ -332,7 +442,7 @@ int FindContacts(const mjModel* m, const mjData* d, const TetherContacts& tc, co
         }
         // Narrow phase in the geom's frame.
         const Closest c =
-            SegmentGeom(type, sz, R.transpose() * (a - pos), R.transpose() * (b - pos));
+            SegmentGeom(type, sz, &cg.hull, R.transpose() * (a - pos), R.transpose() * (b - pos));
         if (!(c.dist < margin)) continue;
         if (count == capacity) {
           ++*dropped;
@@ -345,7 +455,9 @@ int FindContacts(const mjModel* m, const mjData* d, const TetherContacts& tc, co
         cp.normal = R * c.normal;
         cp.velocity = vg + w.cross(cp.point - pos);
         cp.impulse.setZero();
+        cp.impulse_b.setZero();
         cp.stage.setZero();
+        cp.stage_b.setZero();
         cp.tag = body;
       }
     }

@@ -15,9 +15,19 @@ namespace mjtether {
 
 // One geom a tether may touch, with the arc lengths from end A and end B [m] within which its
 // segments skip it (the geom is on that end's body: the tether starts inside or against it).
+// A mesh geom's convex hull in the geom's frame: its triangles (3 corners each) and each
+// triangle's plane (outward unit normal n, offset o: n.p - o is the signed distance to it).
+struct ConvexHull {
+  std::vector<Vec3> corner;  // (3 per triangle)
+  std::vector<Vec3> normal;  // (1 per triangle)
+  std::vector<double> offset;
+  double scale = 1;  // [m] size of the hull (difference step of the normal)
+};
+
 struct ContactGeom {
   int geom = -1;
   double skip[2] = {0, 0};
+  ConvexHull hull;  // mesh geoms only
 };
 
 struct TetherContacts {
@@ -26,8 +36,8 @@ struct TetherContacts {
 };
 
 // Resolves `contact=` ("all" or geom/body names) for a tether whose end sites are site[0],
-// site[1] (-1: free). Supported geom types: plane, sphere, capsule, cylinder, box, ellipsoid.
-// A named mesh or hfield is an error; under `all` they are left out with a warning.
+// site[1] (-1: free). Supported geom types: plane, sphere, capsule, cylinder, box, ellipsoid,
+// mesh (its convex hull). A named hfield is an error; under `all` it is left out with a warning.
 bool ResolveContactGeoms(const mjModel* m, const std::string& spec, const int site[2],
                          const Tether& tether, TetherContacts* out,
                          std::vector<std::string>* warnings, std::string* error);

@@ -358,8 +358,8 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
         if (c.impulse.isZero(0)) continue;
         total += c.impulse;
         // The attached end nodes' share reaches the sites' bodies.
-        if (c.segment == 0) end_a += (1 - c.s) * c.impulse / dt;
-        if (c.segment == tether.segments() - 1 && !free_end) end_b += c.s * c.impulse / dt;
+        if (c.segment == 0) end_a += (c.impulse - c.impulse_b) / dt;
+        if (c.segment == tether.segments() - 1 && !free_end) end_b += c.impulse_b / dt;
         double* r = rec + kContactRecord * stored++;
         r[0] = c.tag;
         for (int i = 0; i < 3; ++i) {

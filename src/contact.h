@@ -13,18 +13,21 @@ namespace mjtether {
 
 // One candidate: the point of segment `segment` at fraction `s` against the plane through
 // `point` with unit normal `normal` (out of the other body). The plane moves with `velocity`:
-// at time t its point is point + velocity (t - time_ref). The segment point's gap is
-//   g = normal . (x_s - p(t)) - d/2,   x_s = (1 - s) x_j + s x_{j+1},
-// and it is in contact while g < 0.
+// at time t its point is point + velocity (t - time_ref). Along the segment the gap is
+//   g(s) = normal . (x_s - p(t)) - d/2,   x_s = (1 - s) x_j + s x_{j+1},
+// and the segment is in contact where g < 0 (the force integrates over it, Tether::
+// ContactForce; `s`, the closest point when the candidate was found, is for information).
 struct ContactPoint {
-  int segment = 0;               // j, 0 <= j < N
-  double s = 0;                  // [-] 0 at node j, 1 at node j+1
-  Vec3 point = Vec3::Zero();     // [m] surface point at time_ref, world frame
-  Vec3 normal = Vec3::UnitZ();   // [-] unit, pointing out of the other body
-  Vec3 velocity = Vec3::Zero();  // [m/s] velocity of the body's material point at `point`
-  Vec3 impulse = Vec3::Zero();   // [N s] out: impulse on the tether, summed by Advance
-  Vec3 stage = Vec3::Zero();     // [N s] scratch (first stage of implicit2)
-  int tag = -1;                  // the caller's (the MuJoCo glue: the geom's body)
+  int segment = 0;                // j, 0 <= j < N
+  double s = 0;                   // [-] 0 at node j, 1 at node j+1
+  Vec3 point = Vec3::Zero();      // [m] surface point at time_ref, world frame
+  Vec3 normal = Vec3::UnitZ();    // [-] unit, pointing out of the other body
+  Vec3 velocity = Vec3::Zero();   // [m/s] velocity of the body's material point at `point`
+  Vec3 impulse = Vec3::Zero();    // [N s] out: impulse on the tether, summed by Advance
+  Vec3 impulse_b = Vec3::Zero();  // [N s] out: the part of `impulse` on node j+1
+  Vec3 stage = Vec3::Zero();      // [N s] scratch (first stage of implicit2)
+  Vec3 stage_b = Vec3::Zero();    // [N s] scratch: its part on node j+1
+  int tag = -1;                   // the caller's (the MuJoCo glue: the geom's body)
 };
 
 // The candidates of one Advance (owned by the caller; Advance only writes `impulse`/`stage`).

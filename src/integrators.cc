@@ -346,23 +346,23 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         d(1, 1) += h * secant;
       }
     }
-    // Contact: normal stiffness and damping L0 (h^2 k + h c) n n^T and the friction's
-    // derivative in the tangent plane at the contact point, shared by the segment's
-    // nodes with the weights (1 - s), s of the force (so w_a w_b on each block).
+    // Contact: the penalty's stiffness k L0 K n n^T (K the 2 x 2 of ContactEval over the two
+    // nodes), and the damping L0 c lambda n n^T and the friction's derivative in the tangent
+    // plane at sbar, shared by the nodes with the weights (1 - sbar), sbar of the force.
     if (Has(kContact) && next.contacts) {
       const ContactSet& set = *next.contacts;
       const double dt_ref = next.time - set.time_ref;
       for (int k = 0; k < set.count; ++k) {
         const ContactPoint& c = set.points[k];
-        double N;
-        ContactForce(c, xk.data(), vk.data(), dt_ref, &N);
-        const Vec3 xs = (1 - c.s) * xk.col(c.segment) + c.s * xk.col(c.segment + 1);
-        if (!(c.normal.dot(xs - c.point - dt_ref * c.velocity) < 0.5 * p_.diameter)) continue;
+        const ContactEval ce = ContactForce(c, xk.data(), vk.data(), dt_ref);
+        if (ce.length == 0) continue;
         const Mat3 nn = c.normal * c.normal.transpose();
-        Mat3 B = (rest_length(c.segment) * (h2 * contact_k_ + h * contact_c_)) * nn;
+        const double L0c = rest_length(c.segment);
+        Mat3 B = (L0c * h * contact_c_ * ce.length) * nn;
+        const double N = ce.N;
         if (p_.contact_friction > 0 && N > 0) {
-          const Vec3 vrel = (1 - c.s) * vk.col(c.segment) + c.s * vk.col(c.segment + 1) -
-                            c.velocity;
+          const double sb = ce.sbar;
+          const Vec3 vrel = (1 - sb) * vk.col(c.segment) + sb * vk.col(c.segment + 1) - c.velocity;
           const Vec3 vt = vrel - c.normal.dot(vrel) * c.normal;
           const double slip = vt.norm();
           const double eps = p_.contact_friction_speed;
@@ -380,11 +380,12 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
           }
         }
         const int j = c.segment;
-        const double wa = 1 - c.s, wb = c.s;
+        const double wa = 1 - ce.sbar, wb = ce.sbar;
+        const Mat3 S = (h2 * contact_k_ * L0c) * nn;
         const bool d0 = Dynamic(j), d1 = Dynamic(j + 1);
-        if (d0) A.D(j - 1) += (wa * wa) * B;
-        if (d1) A.D(j) += (wb * wb) * B;
-        if (d0 && d1) A.L1(j) += (wa * wb) * B;
+        if (d0) A.D(j - 1) += (wa * wa) * B + ce.K[0] * S;
+        if (d1) A.D(j) += (wb * wb) * B + ce.K[2] * S;
+        if (d0 && d1) A.L1(j) += (wa * wb) * B + ce.K[1] * S;
       }
     }
     if (A.Factor() >= 0) return false;
@@ -432,9 +433,10 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
           if (after || !Dynamic(i)) return vk.col(i);
           return vk.col(i) - rhs.col(i - 1);
         };
+        const double sb = ContactForce(c, xk.data(), vk.data(), next.time - set.time_ref).sbar;
         auto slip = [&](bool after) {
-          const Vec3 vr = (1 - c.s) * node_v(c.segment, after) +
-                          c.s * node_v(c.segment + 1, after) - c.velocity;
+          const Vec3 vr =
+              (1 - sb) * node_v(c.segment, after) + sb * node_v(c.segment + 1, after) - c.velocity;
           return (vr - c.normal.dot(vr) * c.normal).norm();
         };
         if (std::abs(std::tanh(slip(true) / eps) - std::tanh(slip(false) / eps)) > 0.1) {
@@ -564,7 +566,10 @@ void Tether::Sdirk2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, dou
   // Contact impulse: y+ = y + (1 - gamma) h F(Y1) + gamma h F(Y2); the first part is kept
   // aside until the second stage settles (a fallback replaces both).
   if (Has(kContact) && mid.contacts) {
-    for (int k = 0; k < mid.contacts->count; ++k) mid.contacts->points[k].stage.setZero();
+    for (int k = 0; k < mid.contacts->count; ++k) {
+      mid.contacts->points[k].stage.setZero();
+      mid.contacts->points[k].stage_b.setZero();
+    }
     AccumulateContactImpulse(x.data(), v.data(), mid, (1 - kGamma) * h, true);
   }
   // x, v hold Y1; form y~ on the dynamic nodes (the ends are set by the next stage).
@@ -579,6 +584,7 @@ void Tether::Sdirk2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, dou
     for (int k = 0; k < next.contacts->count; ++k) {
       ContactPoint& c = next.contacts->points[k];
       c.impulse += c.stage;
+      c.impulse_b += c.stage_b;
     }
     AccumulateContactImpulse(x.data(), v.data(), next, kGamma * h, false);
   }

@@ -215,8 +215,17 @@ class Tether {
   void AddSeabed(ConstNodes x, ConstNodes v, ConstNodes q, Nodes f, const Start* start) const;
   void AddSeabedSurface(ConstNodes x, ConstNodes v, ConstNodes q, Nodes f,
                         const Start* start) const;
-  Vec3 ContactForce(const ContactPoint& c, const double* xp, const double* vp, double dt_ref,
-                    double* normal_force) const;
+  // One candidate's force on its segment (forces.cc): the total F, the normal force N, the
+  // fraction sbar of the segment at which it acts (F goes (1 - sbar) to node j, sbar to node
+  // j+1), the fraction of the segment in contact, and the elastic stiffness blocks
+  // dF_j/dg_a, dF_j/dg_b (= dF_{j+1}/dg_a), dF_{j+1}/dg_b per k L0 (times n n^T).
+  struct ContactEval {
+    Vec3 F = Vec3::Zero();
+    double N = 0, sbar = 0.5, length = 0;
+    double K[3] = {0, 0, 0};
+  };
+  ContactEval ContactForce(const ContactPoint& c, const double* xp, const double* vp,
+                           double dt_ref) const;
   void AddContact(ConstNodes x, ConstNodes v, const Ends& ends, Nodes f) const;
   void AccumulateContactImpulse(const double* x, const double* v, const Ends& ends, double weight,
                                 bool to_stage) const;
