@@ -124,12 +124,20 @@ int Tether::Regrid(double* xp, double* vp, const Ends& e, Payout* p) const {
 }
 
 StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends& to, double dt,
-                           double* work, Payout* p) const {
-  if (!p) return Advance(xp, vp, from, to, dt, work);
+                           double* work, Payout* p, double* history) const {
+  if (!p) return Advance(xp, vp, from, to, dt, work, history);
   StepStatus status;
   const int steps = SubstepsFor(dt);
   if (steps == 0) return status;
   const double h = dt / steps;
+  // bdf2's history over the whole allocation (as x and v), viewed from the drum exit like
+  // the state; without a caller's, one in the workspace for this call.
+  const int n = N_ + 1;
+  double h_prev = 0;
+  const Work w(work, N_);
+  double* hx = history ? history + 1 : w.x0;
+  double* hv = history ? history + 1 + 3 * n : w.v0;
+  double* hh = history ? history : &h_prev;
   Ends now = from;
   now.rest = p->rest;
   for (int k = 0; k < steps; ++k) {
@@ -139,10 +147,13 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
     const int na = view.nodes();
     Nodes x(xp + 3 * p->first, 3, na), v(vp + 3 * p->first, 3, na);
     view.PlaceEnds(now, x, v);
-    view.Step(x, v, now, next, h, work, &status);
+    const History hist{hh, hx + 3 * p->first, hv + 3 * p->first};
+    view.Step(x, v, now, next, h, work, &status, &hist);
     p->rest = next.rest;
     // At most one node per step: a payout of more than L0/2 per tether step is refused at load.
-    Regrid(xp, vp, next, p);
+    // A node inserted or removed restarts bdf2 (its history is not remapped: the new node
+    // has none, and a removal changes a neighbour's velocity); docs/numerics.md.
+    if (Regrid(xp, vp, next, p) != 0) *hh = 0;
     now = next;
     now.rest = p->rest;
   }
