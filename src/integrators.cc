@@ -642,7 +642,12 @@ void Tether::Bdf2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, doubl
 void Tether::Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h, double* work,
                   StepStatus* status, const History* history) const {
   if (p_.integrator == Integrator::kBdf2) {
-    Bdf2Step(x, v, now, next, h, work, status, *history);
+    // Without a history (a winch tether advanced without one): backward Euler.
+    if (history) {
+      Bdf2Step(x, v, now, next, h, work, status, *history);
+    } else {
+      ImplicitStepAdaptive(x, v, now, next, h, 0, work, status);
+    }
   } else if (p_.integrator == Integrator::kExplicit) {
     ExplicitStep(x, v, now, next, h, work);
   } else if (p_.integrator == Integrator::kRK4) {

@@ -123,6 +123,7 @@ int Tether::Regrid(double* xp, double* vp, const Ends& e, Payout* p) const {
   return 0;
 }
 
+// Without a caller's `history` a bdf2 tether's steps here are backward Euler.
 StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends& to, double dt,
                            double* work, Payout* p, double* history) const {
   if (!p) return Advance(xp, vp, from, to, dt, work, history);
@@ -131,13 +132,13 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
   if (steps == 0) return status;
   const double h = dt / steps;
   // bdf2's history over the whole allocation (as x and v), viewed from the drum exit like
-  // the state; without a caller's, one in the workspace for this call.
+  // the state. Without a caller's history the steps are backward Euler (the views' scratch
+  // layouts differ from the whole tether's, so the workspace cannot hold one).
   const int n = N_ + 1;
-  double h_prev = 0;
-  const Work w(work, N_);
-  double* hx = history ? history + 1 : w.x0;
-  double* hv = history ? history + 1 + 3 * n : w.v0;
-  double* hh = history ? history : &h_prev;
+  double unused = 0;
+  double* hh = history ? history : &unused;
+  double* hx = history ? history + 1 : nullptr;
+  double* hv = history ? history + 1 + 3 * n : nullptr;
   Ends now = from;
   now.rest = p->rest;
   for (int k = 0; k < steps; ++k) {
@@ -147,8 +148,9 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
     const int na = view.nodes();
     Nodes x(xp + 3 * p->first, 3, na), v(vp + 3 * p->first, 3, na);
     view.PlaceEnds(now, x, v);
-    const History hist{hh, hx + 3 * p->first, hv + 3 * p->first};
-    view.Step(x, v, now, next, h, work, &status, &hist);
+    const History hist{hh, history ? hx + 3 * p->first : nullptr,
+                       history ? hv + 3 * p->first : nullptr};
+    view.Step(x, v, now, next, h, work, &status, history ? &hist : nullptr);
     p->rest = next.rest;
     // At most one node per step: a payout of more than L0/2 per tether step is refused at load.
     // A node inserted or removed restarts bdf2 (its history is not remapped: the new node

@@ -124,6 +124,24 @@ TEST(Bdf2, KeepsThe5HzWaveWhereBackwardEulerDampsIt) {
   }
 }
 
+// A declaration without `integrator` gets bdf2; `implicit` is still backward Euler by name, and
+// an unknown name lists bdf2 first as the default.
+TEST(Bdf2, IsTheDefaultAndImplicitStaysBackwardEuler) {
+  DeclarationError e;
+  const std::string base = "ends=a,b length=10 segments=10 diameter=0.02 mass_per_length=1 EA=1e5";
+  std::optional<TetherDeclaration> d = ParseTether(base, Environment(), &e);
+  ASSERT_TRUE(d) << e.message;
+  EXPECT_EQ(d->params.integrator, Integrator::kBdf2);
+  EXPECT_STREQ(IntegratorName(d->params.integrator), "bdf2");
+  d = ParseTether(base + " integrator=implicit", Environment(), &e);
+  ASSERT_TRUE(d) << e.message;
+  EXPECT_EQ(d->params.integrator, Integrator::kImplicit);
+  EXPECT_FALSE(ParseTether(base + " integrator=bdf3", Environment(), &e));
+  EXPECT_NE(e.message.find("allowed: bdf2 (default), implicit, implicit2, explicit, rk4"),
+            std::string::npos)
+      << e.message;
+}
+
 std::string DefaultModelWith(const std::string& integrator) {
   std::ifstream f(std::string(MJTETHER_MODELS_DIR) + "/rov_tether.xml");
   std::stringstream s;
