@@ -822,7 +822,8 @@ int DofsAbove(const mjModel* m, int b) {
 // Accuracy and cost: explicit 25 ns, rk4 96 ns, implicit 136 ns per node and step at 80
 // segments; implicit2 two implicit solves).
 double CostPerSecond(const Tether& t, double timestep) {
-  static constexpr double kNsPerNodeStep[] = {25e-9, 136e-9, 272e-9, 96e-9, 140e-9};  // Integrator order
+  // In Integrator order: explicit, implicit, implicit2, rk4, bdf2.
+  static constexpr double kNsPerNodeStep[] = {25e-9, 136e-9, 272e-9, 96e-9, 140e-9};
   const int steps = t.SubstepsFor(timestep);
   return steps / timestep * t.nodes() * kNsPerNodeStep[static_cast<int>(t.params().integrator)];
 }
