@@ -82,7 +82,9 @@ CouplingLimit GetCouplingLimit(const mjModel* m, int k, int end);
 constexpr double kCouplingLimitExplicit = 2.0;
 constexpr double kCouplingLimitRk4 = 0.8;
 // implicit2 (after the semismooth Newton of issue 11 item 4): within 1% at omega h = 3.36, 3.4%
-// off in position at 10.6 on the same case; refused from 4. implicit has no limit.
+// off in position at 10.6 on the same case; refused from 4. implicit has no limit, nor bdf2
+// (within 0.2% in position and 0.7% in tension up to omega h = 10.6 on the same cases; the
+// yanked body of coupling_test gains 0.7% of the work at omega h = 3.7, implicit 0.02%).
 constexpr double kCouplingLimitImplicit2 = 4.0;
 // Estimated CPU time [s] the tether takes per simulated second at MuJoCo step `timestep`, from
 // its tether steps and nodes and the per-node costs measured on this project's machine.

@@ -51,7 +51,8 @@ enum Slot : int {
   kStalledTime,                     // [s] d->time of the call that first reported one
   kCoupleA,                         // end A on a body that moves: see CoupleSlot
   kCoupleB = kCoupleA + 5,
-  kHeader = kCoupleB + 5,  // x (3 x n) then v (3 x n) follow, then with contact `capacity` records
+  kHeader = kCoupleB + 5,  // x (3 x n) then v (3 x n) follow, then the integrator's history
+                           // (Tether::HistorySize, bdf2), then with contact `capacity` records
 };
 // A contact reaction record: body, force on it [N] (3), point of application [m] (3), applied
 // at every callback until the next advance replaces them.
@@ -260,6 +261,7 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
   const bool free_end = at.site[1] < 0;
   double* x = u + kHeader;
   double* v = x + 3 * tether.nodes();
+  double* history = tether.HistorySize() > 0 ? x + tether.StateSize() : nullptr;
   Ends now;
   now.a = SiteState(m, d, at, 0, u);
   if (!free_end) now.b = SiteState(m, d, at, 1, u);
@@ -296,6 +298,8 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
     } else {
       tether.InitialShape(now, x, v);
     }
+    // bdf2 starts again with a backward-Euler step (no history yet).
+    if (history) history[0] = 0;
     u[kInitialized] = 1;
     u[kStartTime] = d->time;
     u[kStartStrain] =
@@ -332,12 +336,12 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
       const double speed = WinchSpeed(at.winch_params, drum, ctrl, drum_tension, dt);
       Payout p = LoadPayout(at, u);
       p.speed = speed;
-      status = tether.Advance(x, v, from, now, dt, work, &p);
+      status = tether.Advance(x, v, from, now, dt, work, &p, history);
       wu[kWinchLength] = drum.length + speed * dt;
       wu[kWinchSpeed] = speed;
       wu[kWinchFirst] = p.first;
     } else {
-      status = tether.Advance(x, v, from, now, dt, work);
+      status = tether.Advance(x, v, from, now, dt, work, history);
     }
     if (!status.ok) {
       u[kStatus] = status.reason.rfind("strain", 0) == 0    ? kStrain
@@ -350,7 +354,7 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
     // Each body gets the opposite of the impulse its geoms gave the tether, spread over the
     // next step as a constant force at the contact point.
     if (at.contact) {
-      double* rec = x + tether.StateSize();
+      double* rec = x + tether.StateSize() + tether.HistorySize();
       Vec3 total = Vec3::Zero(), end_a = Vec3::Zero(), end_b = Vec3::Zero();
       int stored = 0;
       for (int k = 0; k < set.count; ++k) {
@@ -391,7 +395,7 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
 
   // Contact reactions of the last advance, at every call until the next one.
   if (at.contact) {
-    const double* rec = x + tether.StateSize();
+    const double* rec = x + tether.StateSize() + tether.HistorySize();
     const mjtNum zero[3] = {0, 0, 0};
     for (int k = 0; k < static_cast<int>(u[kContactCount]); ++k) {
       const double* r = rec + kContactRecord * k;
@@ -818,7 +822,8 @@ int DofsAbove(const mjModel* m, int b) {
 // Accuracy and cost: explicit 25 ns, rk4 96 ns, implicit 136 ns per node and step at 80
 // segments; implicit2 two implicit solves).
 double CostPerSecond(const Tether& t, double timestep) {
-  static constexpr double kNsPerNodeStep[] = {25e-9, 136e-9, 272e-9, 96e-9};  // Integrator order
+  // In Integrator order: explicit, implicit, implicit2, rk4, bdf2.
+  static constexpr double kNsPerNodeStep[] = {25e-9, 136e-9, 272e-9, 96e-9, 140e-9};
   const int steps = t.SubstepsFor(timestep);
   return steps / timestep * t.nodes() * kNsPerNodeStep[static_cast<int>(t.params().integrator)];
 }
@@ -883,8 +888,8 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
         << " kg) = " << c.omega << " rad/s, <option timestep> " << h << " s), limit " << c.limit
         << (p.integrator == Integrator::kImplicit2
                 ? "; use integrator=implicit (measured within 1% at omega h 10.6), or <option "
-                : "; use integrator=implicit (stable at any omega h measured) or implicit2 (up "
-                  "to omega h 4), or <option ")
+                : "; use integrator=implicit or bdf2 (stable at any omega h measured) or "
+                  "implicit2 (up to omega h 4), or <option ")
         << "timestep> <= "
         << c.limit / c.omega << " s, or fewer segments or a smaller EA";
       if (c.omega_h >= c.limit) {
@@ -1093,6 +1098,7 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
       }
     }
     const long long block = kHeader + static_cast<long long>(tether->StateSize()) +
+                            tether->HistorySize() +
                             (at.contact ? kContactRecord * at.contacts.capacity : 0) +
                             (at.winch ? kWinchSlots : 0);
     if (offset + block > 1'000'000'000LL) {

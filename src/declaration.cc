@@ -368,10 +368,12 @@ std::optional<TetherDeclaration> ParseTether(const std::string& text, const Envi
         p.integrator = Integrator::kImplicit2;
       } else if (value == "rk4") {
         p.integrator = Integrator::kRK4;
+      } else if (value == "bdf2") {
+        p.integrator = Integrator::kBdf2;
       } else {
-        ok = Fail(
-            error, key,
-            "key 'integrator' = " + Shown(value) + "; allowed: explicit, implicit, implicit2, rk4");
+        ok = Fail(error, key,
+                  "key 'integrator' = " + Shown(value) +
+                      "; allowed: bdf2 (default), implicit, implicit2, explicit, rk4");
       }
     } else if (key == "bending") {
       if (value == "galerkin") {

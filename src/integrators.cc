@@ -590,9 +590,71 @@ void Tether::Sdirk2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, dou
   }
 }
 
+// BDF2, the two-step backward differentiation formula (Curtiss & Hirschfelder 1952; Hairer &
+// Wanner, Solving ODEs II, ch. III.1 and V.1: A-stable and L-stable, order 2), on
+// y = (x, v), y' = F(y) = (v, a(x, v)), with variable steps (ratio w = h/h_prev; Hairer,
+// Norsett & Wanner, Solving ODEs I, eq. III.5.18, k = 2):
+//   y_{n+1} - yhat = he F(y_{n+1}),  yhat = y_n + w^2/(1 + 2 w) (y_n - y_{n-1}),
+//   he = h (1 + w)/(1 + 2 w)        (w = 1: yhat = (4 y_n - y_{n-1})/3, he = 2 h/3).
+// That is a backward-Euler step of size he from yhat, with the ends at t + h: ImplicitStep
+// solves it (one factorisation per Newton iteration, the matrix M - he D - he^2 K, the same
+// non-smooth handling), so a step costs what a backward-Euler step costs. It is the
+// generalized-alpha scheme of Jansen, Whiting & Hulbert (CMAME 190, 2000) at rho_inf = 0 with
+// a constant step; on the fixed line rho_inf = 0.5-0.95 left the axial modes above the
+// resolved ones ringing where the line's internal damping kills them, 26-29x the time error
+// of rho_inf = 0 at 2 ms (docs/numerics.md).
+// The history is the last step's difference y_n - y_{n-1} and its length h_prev. Without it
+// (the first step, after a reset, a winch regrid, or a step more than kBdf2MaxRatio times the
+// last), and where the Newton iteration does not settle, the step is backward Euler (retried
+// in halves as the implicit scheme does), whose local error O(h^2) once keeps the scheme second
+// order. Contact impulse: h times the final contact force; the BDF2 momentum balance
+// M (3 v_{n+1} - 4 v_n + v_{n-1})/2 = h f_{n+1} sums to that over the steps.
+void Tether::Bdf2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
+                      double* work, StepStatus* stats, const History& hist) const {
+  Work w(work, N_);
+  const int n = N_ + 1;
+  Nodes dx(hist.xd, 3, n), dv(hist.vd, 3, n), xs(w.xs, 3, n), vs(w.vs, 3, n);
+  // Backward Euler from y_n, the difference y_{n+1} - y_n kept.
+  auto backward_euler = [&]() {
+    dx = x;
+    dv = v;
+    ImplicitStepAdaptive(x, v, now, next, h, 0, work, stats);
+    dx = x - dx;
+    dv = v - dv;
+    *hist.h_prev = h;
+  };
+  const double ratio = h / *hist.h_prev;
+  if (!(*hist.h_prev > 0) || !(ratio <= kBdf2MaxRatio)) return backward_euler();
+  const double c = ratio * ratio / (1 + 2 * ratio);       // [-] yhat = y_n + c (y_n - y_{n-1})
+  const double he = h * (1 + ratio) / (1 + 2 * ratio);   // [s]
+  xs = x;
+  vs = v;
+  for (int i = 0; i < n; ++i) {
+    if (!Dynamic(i)) continue;
+    x.col(i) += c * dx.col(i);
+    v.col(i) += c * dv.col(i);
+  }
+  if (!ImplicitStep(x, v, now, next, he, work, stats)) {
+    x = xs;
+    v = vs;
+    return backward_euler();
+  }
+  AccumulateContactImpulse(x.data(), v.data(), next, h, false);
+  dx = x - xs;
+  dv = v - vs;
+  *hist.h_prev = h;  // BDF2 again next step
+}
+
 void Tether::Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h, double* work,
-                  StepStatus* status) const {
-  if (p_.integrator == Integrator::kExplicit) {
+                  StepStatus* status, const History* history) const {
+  if (p_.integrator == Integrator::kBdf2) {
+    // Without a history (a winch tether advanced without one): backward Euler.
+    if (history) {
+      Bdf2Step(x, v, now, next, h, work, status, *history);
+    } else {
+      ImplicitStepAdaptive(x, v, now, next, h, 0, work, status);
+    }
+  } else if (p_.integrator == Integrator::kExplicit) {
     ExplicitStep(x, v, now, next, h, work);
   } else if (p_.integrator == Integrator::kRK4) {
     Rk4Step(x, v, now, next, h, work);
@@ -603,19 +665,29 @@ void Tether::Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
   }
 }
 
+int Tether::HistorySize() const {
+  return p_.integrator == Integrator::kBdf2 ? 1 + 6 * (N_ + 1) : 0;  // h_prev, dx, dv
+}
+
 StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends& to, double dt,
-                           double* work) const {
+                           double* work, double* history) const {
   const int n = N_ + 1;
   Nodes x(xp, 3, n), v(vp, 3, n);
   StepStatus status;
   const int steps = SubstepsFor(dt);
   if (steps == 0) return status;
   const double h = dt / steps;
+  // bdf2 without a caller's history: one in the workspace for this call (x0, v0 are
+  // implicit2's), starting with a backward-Euler step.
+  double h_prev = 0;
+  const Work w(work, N_);
+  const History hist = history ? History{history, history + 1, history + 1 + 3 * n}
+                               : History{&h_prev, w.x0, w.v0};
   Ends now = from;
   PlaceEnds(from, x, v);
   for (int k = 0; k < steps; ++k) {
     const Ends next = k + 1 == steps ? to : Interpolate(from, to, dt, double(k + 1) / steps);
-    Step(x, v, now, next, h, work, &status);
+    Step(x, v, now, next, h, work, &status, &hist);
     // Work of the end forces over the step: the integrator's last force evaluation (explicit:
     // start of the step; implicit: the last Newton iterate; rk4: the last stage).
     const ConstNodes f(Work(work, N_).f, 3, n);

@@ -53,6 +53,7 @@ enum class Integrator {
   kImplicit,  // linearised backward Euler, banded solve
   kImplicit2,  // two-stage L-stable SDIRK (second order), each stage a backward-Euler solve
   kRK4,       // classical fourth-order Runge-Kutta, substeps from its own stability limit
+  kBdf2,  // generalized-alpha (second order, one backward-Euler-sized solve per step)
 };
 
 // Explicit schemes take substeps at their stability limit; implicit ones take the MuJoCo step.
@@ -64,6 +65,7 @@ inline const char* IntegratorName(Integrator i) {
     case Integrator::kImplicit: return "implicit";
     case Integrator::kImplicit2: return "implicit2";
     case Integrator::kRK4: return "rk4";
+    case Integrator::kBdf2: return "bdf2";
   }
   return "?";
 }
@@ -112,7 +114,7 @@ struct TetherParams {
   double Cdn = 0;              // [-] normal drag coefficient, reference area d per length
   double Cdt = 0;              // [-] tangential drag coefficient, reference area pi*d per length
   double Can = 0;              // [-] normal added-mass coefficient, reference pi*d^2/4 per length
-  Integrator integrator = Integrator::kImplicit;
+  Integrator integrator = Integrator::kBdf2;  // the declaration's default (docs/numerics.md)
   Bending bending = Bending::kGalerkin;  // curvature formulation (bending=galerkin|der)
   bool free_end = false;       // end B is not attached (dangling)
   bool clamp_a = false;        // end A tangent held along its site's x-axis

@@ -124,16 +124,26 @@ class Tether {
   // below the seabed. Velocities: zero inside, the sites' at the ends.
   void InitialShape(const Ends& ends, double* x, double* v) const;
 
+  // Doubles of integrator history a state carries besides x and v: with integrator=bdf2, the
+  // last step h_prev [s] (0: none yet) and the last step's change of x and v (3 x (N+1) each),
+  // 1 + 6 (N+1); 0 with the one-step schemes. All zero is a valid history (no step yet): the
+  // next step is then a backward-Euler step, which starts the scheme (docs/numerics.md).
+  int HistorySize() const;
+
   // Advances the state by dt [s]; the attached ends move from `from` to `to` (cubic Hermite in
   // time between the two, so positions and velocities at both instants are matched).
+  // `history` (HistorySize() doubles, see above) carries bdf2's last step from one call to the
+  // next; without it each call starts again with a backward-Euler step (first order when a
+  // call is a single step), the later steps of the same call being BDF2.
   StepStatus Advance(double* x, double* v, const Ends& from, const Ends& to, double dt,
-                     double* work) const;
+                     double* work, double* history = nullptr) const;
   // The same for a tether with a winch at end A (params().winch): the winch segment's rest
   // length grows by payout->speed dt over the advance (linearly), and whenever it leaves
   // [0.5, 1.5] L0 a node is inserted at or removed from the drum (Regrid); *payout is updated.
   // x and v hold the whole allocation, segments() + 1 nodes.
+  // With bdf2, a node inserted or removed restarts the scheme (one backward-Euler step).
   StepStatus Advance(double* x, double* v, const Ends& from, const Ends& to, double dt,
-                     double* work, Payout* payout) const;
+                     double* work, Payout* payout, double* history = nullptr) const;
 
   // The deployed part of a tether with a winch as a tether of its own: segments() - first
   // segments, the first of rest length `rest` [m], the nodes' lumped masses, weights and
@@ -248,6 +258,15 @@ class Tether {
 
   void Sdirk2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
                   double* work, StepStatus* stats) const;
+  // The BDF2 history of the nodes being stepped (a Deployed view's nodes): the step that made
+  // the state [s] (0: none) and the change of x and v over it (3 x n).
+  struct History {
+    double* h_prev;
+    double* xd;
+    double* vd;
+  };
+  void Bdf2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
+                    double* work, StepStatus* stats, const History& history) const;
 
   bool Has(unsigned effect) const { return (p_.effects & effect) != 0; }
   bool Dynamic(int i) const { return i > 0 && (i < N_ || p_.free_end); }
@@ -319,7 +338,7 @@ class Tether {
   }
   // One tether step of the configured integrator (the body of Advance's loop).
   void Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h, double* work,
-            StepStatus* status) const;
+            StepStatus* status, const History* history) const;
   // The divergence checks at the end of an Advance.
   void Check(ConstNodes x, ConstNodes v, const Ends& from, const Ends& to,
              StepStatus* status) const;

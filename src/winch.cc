@@ -120,13 +120,22 @@ int Tether::Regrid(double* xp, double* vp, const Ends& e, Payout* p) const {
   return 0;
 }
 
+// Without a caller's `history` a bdf2 tether's steps here are backward Euler.
 StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends& to, double dt,
-                           double* work, Payout* p) const {
-  if (!p) return Advance(xp, vp, from, to, dt, work);
+                           double* work, Payout* p, double* history) const {
+  if (!p) return Advance(xp, vp, from, to, dt, work, history);
   StepStatus status;
   const int steps = SubstepsFor(dt);
   if (steps == 0) return status;
   const double h = dt / steps;
+  // bdf2's history over the whole allocation (as x and v), viewed from the drum exit like
+  // the state. Without a caller's history the steps are backward Euler (the views' scratch
+  // layouts differ from the whole tether's, so the workspace cannot hold one).
+  const int n = N_ + 1;
+  double unused = 0;
+  double* hh = history ? history : &unused;
+  double* hx = history ? history + 1 : nullptr;
+  double* hv = history ? history + 1 + 3 * n : nullptr;
   Ends now = from;
   now.rest = p->rest;
   for (int k = 0; k < steps; ++k) {
@@ -136,10 +145,14 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
     const int na = view.nodes();
     Nodes x(xp + 3 * p->first, 3, na), v(vp + 3 * p->first, 3, na);
     view.PlaceEnds(now, x, v);
-    view.Step(x, v, now, next, h, work, &status);
+    const History hist{hh, history ? hx + 3 * p->first : nullptr,
+                       history ? hv + 3 * p->first : nullptr};
+    view.Step(x, v, now, next, h, work, &status, history ? &hist : nullptr);
     p->rest = next.rest;
     // At most one node per step: a payout of more than L0/2 per tether step is refused at load.
-    Regrid(xp, vp, next, p);
+    // A node inserted or removed restarts bdf2 (its history is not remapped: the new node
+    // has none, and a removal changes a neighbour's velocity); docs/numerics.md.
+    if (Regrid(xp, vp, next, p) != 0) *hh = 0;
     now = next;
     now.rest = p->rest;
   }

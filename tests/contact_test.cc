@@ -366,9 +366,13 @@ TEST_P(EveryGeomType, TetherStaysOutside) {
   </worldbody>
   <custom>
     <text name="tether:t" data="ends=a,free length=0.6 segments=15 diameter=0.02
-      mass_per_length=1 EA=1e5 damping=20 contact=g contact_friction=0.3"/>
+      mass_per_length=1 EA=1e5 damping=20 contact=g contact_friction=0.3 integrator=implicit"/>
   </custom>
 </mujoco>)";
+  // Backward Euler declared (issue 17): the contact mode, sqrt(k L0/m) h = 2 at this step, is not
+  // resolved, and backward Euler damps it; with bdf2 the tether's axis came to 2.4 mm of the
+  // sphere (7.6 mm into its radius) where the check allows 5 mm. Which is nearer the converged
+  // penetration is not measured yet (open, docs/numerics.md).
   LoadedScene s(xml);
   ASSERT_NE(s.d, nullptr);
   auto sdf = [&](const Vec3& p) -> double {

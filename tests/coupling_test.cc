@@ -146,7 +146,7 @@ TEST_P(CouplingCases, AgreeWithTheFineStepOrAreRefusedAtLoad) {
 INSTANTIATE_TEST_SUITE_P(BlueRov2, CouplingCases,
                          ::testing::Combine(::testing::Values("6e4", "1e6", "1e7", "1e8"),
                                             ::testing::Values("explicit", "rk4", "implicit",
-                                                              "implicit2")),
+                                                              "implicit2", "bdf2")),
                          [](const auto& info) {
                            std::string ea = std::get<0>(info.param);
                            ea[ea.find('e')] = '_';
@@ -234,7 +234,7 @@ TEST_F(Coupling, ChatterIsStoppedWithTetherBodyAndSetting) {
 // integrator at 2 ms, or, where the advisor refuses that, at the largest of 0.5 and 0.25 ms it
 // accepts (explicit 0.5 ms, omega h = 0.92; rk4 0.25 ms, 0.46: at 0.5 ms rk4 gained 8%).
 TEST_F(Coupling, YankedVehicleGainsNoEnergyBeyondTheWork) {
-  for (const char* integrator : {"implicit", "implicit2", "explicit", "rk4"}) {
+  for (const char* integrator : {"implicit", "implicit2", "bdf2", "explicit", "rk4"}) {
     for (double h : {0.002, 0.0005, 0.00025}) {
       const std::string xml = R"(<mujoco><option timestep=")" + std::to_string(h) +
                               R"(" gravity="0 0 0"><flag energy="enable"/></option>
@@ -365,7 +365,7 @@ TEST(CouplingCli, RefusalExitsWith2AndInfoPrintsEachLimit) {
   std::string output;
   EXPECT_EQ(RunCli("run " + path + " --duration 0.1", &output), 2) << output;
   EXPECT_TRUE(Contains(output, "omega h = ")) << output;
-  EXPECT_TRUE(Contains(output, "use integrator=implicit (stable")) << output;
+  EXPECT_TRUE(Contains(output, "use integrator=implicit or bdf2 (stable")) << output;
   const std::string ok = ::testing::TempDir() + "/coupling_ok.xml";
   std::ofstream(ok) << BlueRovXml("1e7", "implicit", 0.002);
   EXPECT_EQ(RunCli("info " + ok, &output), 0) << output;

@@ -128,7 +128,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"free end A", With("ends=tms_port,rov_attach", "ends=free,b"), "ends",
                 "only end B"},
         BadCase{"bad integrator", With("integrator=implicit", "integrator=rk9"), "integrator",
-                "explicit, implicit"},
+                "bdf2 (default), implicit, implicit2, explicit, rk4"},
         BadCase{"bad clamp", std::string(kExample) + " clamp=C", "clamp", "A, B, both"},
         BadCase{"clamp without EI", With("EI=0.5", "EI=0") + " clamp=A", "clamp", "EI > 0"},
         BadCase{"clamp a free end",

@@ -260,6 +260,7 @@ inline Run RunEngine(const Scene& s, int N, const std::string& integrator, doubl
   }
   r.step = outer / t->SubstepsFor(outer);
   std::vector<double> x(3 * t->nodes()), v(3 * t->nodes()), work(t->WorkspaceSize());
+  std::vector<double> history(t->HistorySize() + 1);  // bdf2's last step between calls
   const long steps = std::lround(s.duration / outer);
   const long every = std::max(1L, std::lround(s.sample / outer));
   auto record = [&](const Ends& ends) {
@@ -292,7 +293,7 @@ inline Run RunEngine(const Scene& s, int N, const std::string& integrator, doubl
       r.cpu -= resume.cpu - pause.cpu;
     }
     const Ends to = EndsAt(s, (k + 1) * outer);
-    StepStatus st = t->Advance(x.data(), v.data(), from, to, outer, work.data());
+    StepStatus st = t->Advance(x.data(), v.data(), from, to, outer, work.data(), history.data());
     if (!st.ok) {
       r.ok = false;
       break;

@@ -283,7 +283,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"huge_coefficient", kGoodWater, BadTether("Cdn=1.2", "Cdn=1e9"), "tether:u", "Cdn",
                  "[0, 100]"},
         BadInput{"bad_word", kGoodWater, std::string(kGoodTether) + " integrator=rk5", "tether:u",
-                 "integrator", "explicit, implicit"},
+                 "integrator", "bdf2 (default), implicit, implicit2, explicit, rk4"},
         BadInput{"missing_site", kGoodWater, BadTether("ends=a,b", "ends=a,c"), "tether:u", "ends",
                  "no site named 'c'"},
         BadInput{"same_site_twice", kGoodWater, BadTether("ends=a,b", "ends=b,b"), "tether:u",

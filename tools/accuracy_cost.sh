@@ -7,6 +7,7 @@
 #   accuracy_cost.md    the same as markdown tables, one per scene
 #   accuracy_cost_line.png, accuracy_cost_scenes.png   the charts shown in docs/accuracy_cost.md
 #   machine.txt         where and when it was measured
+# Series: explicit, implicit, implicit2, rk4, bdf2 (engine alone and through MuJoCo), rope.
 # About 11 minutes on the 2-core machine (5 of them the 640-segment reference of the line). Usage:
 #   tools/accuracy_cost.sh [BUILD_DIR] [driver options, e.g. --scenes line]
 #   tools/accuracy_cost.sh --plot-only      (charts again from the committed CSV)

@@ -25,6 +25,9 @@ constexpr double kLinearisationTolerance = 0.01;
 constexpr double kNewtonTolerance = 1e-2;
 constexpr int kMaxNewton = 12;
 constexpr double kMinLineSearchStep = 1.0 / 64;
+// bdf2 restarts with a backward-Euler step when the step grows by more than this ratio over
+// the last (variable-step BDF2 is zero-stable below 1 + sqrt(2); docs/numerics.md).
+constexpr double kBdf2MaxRatio = 2;
 // Kinetic energy above this multiple of EnergyBound() is a blow-up (the bound is already
 // generous; the factor keeps a violent but physical transient, e.g. a whipping free end,
 // clear of it).

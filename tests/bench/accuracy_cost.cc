@@ -360,6 +360,8 @@ struct Options {
   std::vector<int> rope_links = {10, 20, 40};
   bool rope_only = false;  // debugging: only the composite rope runs
   std::vector<double> steps = {0.05, 0.02, 0.01, 0.005, 0.002, 0.001};  // [s] implicit steps
+  std::vector<int> segments;  // non-empty: only these N
+  int reference = 0;          // > 0: the finest reference's N
 };
 
 }  // namespace
@@ -381,6 +383,13 @@ int main(int argc, char** argv) {
       std::stringstream ss(argv[++i]);
       std::string item;
       while (std::getline(ss, item, ',')) o.steps.push_back(std::stod(item));
+    } else if (a == "--segments" && i + 1 < argc) {
+      // Debugging aid: only these segment counts (engine and MuJoCo), no composite rope.
+      std::stringstream ss(argv[++i]);
+      std::string item;
+      while (std::getline(ss, item, ',')) o.segments.push_back(std::stoi(item));
+    } else if (a == "--reference" && i + 1 < argc) {
+      o.reference = std::stoi(argv[++i]);  // debugging aid: the finest reference's N
     } else if (a == "--scenes" && i + 1 < argc) {
       o.scenes.clear();
       std::stringstream ss(argv[++i]);
@@ -409,6 +418,8 @@ int main(int argc, char** argv) {
       s.segments = {10, 20};
       s.reference_segments = 40;
     }
+    if (!o.segments.empty()) s.segments = o.segments;
+    if (o.reference > 0) s.reference_segments = o.reference;
     std::fprintf(stderr, "scene %s\n", name.c_str());
     if (o.rope_only) {
       for (int links : o.rope_links) {
@@ -480,19 +491,21 @@ int main(int argc, char** argv) {
         if (h > s.sample + 1e-12) continue;
         finish(RunEngine(s, N, "implicit", h, 0, true));
         finish(RunEngine(s, N, "implicit2", h, 0, true));
+        finish(RunEngine(s, N, "bdf2", h, 0, true));
       }
     }
     if (name == "line" && !o.quick) {
       // Through MuJoCo, the fairlead on a mocap body; the MuJoCo step is the tether step.
-      for (int N : {20, 80}) {
+      for (int N : o.segments.empty() ? std::vector<int>{20, 80} : o.segments) {
         finish(RunMujoco(s, N, "explicit", 0.002, 0));
         finish(RunMujoco(s, N, "rk4", 0.002, 0));
         for (double h : {0.01, 0.002}) {
           finish(RunMujoco(s, N, "implicit", h, 0));
           finish(RunMujoco(s, N, "implicit2", h, 0));
+          finish(RunMujoco(s, N, "bdf2", h, 0));
         }
       }
-      for (int links : o.rope_links) {
+      for (int links : o.segments.empty() ? o.rope_links : std::vector<int>{}) {
         for (double h : {0.005, 0.002, 0.001}) {
           if (links >= 40 && h < 0.002) continue;  // 0.5 s of wall time per simulated second
           finish(RunRope(s, links, h));

@@ -73,11 +73,13 @@ void Step(benchmark::State& state, const char* integrator, bool tether) {
 }
 
 void BM_StepImplicit(benchmark::State& s) { Step(s, "implicit", true); }
+void BM_StepBdf2(benchmark::State& s) { Step(s, "bdf2", true); }
 void BM_StepExplicit(benchmark::State& s) { Step(s, "explicit", true); }
 void BM_StepRk4(benchmark::State& s) { Step(s, "rk4", true); }
 void BM_StepNoTether(benchmark::State& s) { Step(s, "implicit", false); }
 
 BENCHMARK(BM_StepImplicit)->Arg(10)->Arg(20)->Arg(50)->Arg(100)->Arg(200);
+BENCHMARK(BM_StepBdf2)->Arg(10)->Arg(20)->Arg(50)->Arg(100)->Arg(200);
 BENCHMARK(BM_StepExplicit)->Arg(10)->Arg(20)->Arg(50)->Arg(100)->Arg(200);
 BENCHMARK(BM_StepRk4)->Arg(10)->Arg(20)->Arg(50)->Arg(100)->Arg(200);
 BENCHMARK(BM_StepNoTether)->Arg(10);

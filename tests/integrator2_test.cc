@@ -1,0 +1,240 @@
+// The default integrator, bdf2 (issue 17 item 1; docs/numerics.md): second order at backward
+// Euler's cost per step, its history in mjData.
+//
+// - order of convergence ~2 against a converged reference (backward Euler's ~1 alongside);
+// - a 5 Hz transverse wave keeps its amplitude over the time it takes to travel 10 m;
+// - mj_copyData and mj_resetData carry the history: bit-identical runs;
+// - a winch payout and haul-in with bdf2 stays within the winch tests' tolerances (a regrid
+//   restarts the scheme with one backward-Euler step).
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "mjtether.h"
+#include "mujoco_fixture.h"
+#include "reference_scenes.h"
+
+namespace mjtether {
+namespace {
+
+using namespace reference_scenes;
+
+double Rms(const std::vector<double>& a, const std::vector<double>& b, size_t from) {
+  double s = 0;
+  for (size_t i = from; i < a.size(); ++i) s += (a[i] - b[i]) * (a[i] - b[i]);
+  return std::sqrt(s / (a.size() - from));
+}
+
+// Observed order on the fixed comparison line (tests/reference_scenes.h) at 20 segments, 20 s
+// (the error over 10-20 s, after the start-up snap): the fairlead tension's RMS error against
+// rk4 at 0.25 ms (fourth order: its time error is ~(0.25/1)^4 of rk4 at 1 ms, far below what
+// is measured here) at h = 4, 2 and 1 ms. Second order halves the step and quarters the
+// error: log2 of the ratios within 1.6-2.4 (the ratio of a second-order error settles to 4 as
+// h -> 0; the higher-order terms are a few % at these steps). Backward Euler, run alongside,
+// is first order, and at these steps still short of it (its damping of the line's axial modes
+// dominates: measured 0.4-0.6): below 1.3, so the test tells the two apart.
+TEST(Bdf2, ObservedOrderIsTwo) {
+  Scene s = LineScene();
+  s.duration = 20;
+  const int N = 20;
+  const reference_scenes::Run ref = RunEngine(s, N, "rk4", 0.002, 0.00025, false);
+  ASSERT_TRUE(ref.ok);
+  const size_t from = std::lround(s.error_from / s.sample);
+  for (const char* integrator : {"bdf2", "implicit"}) {
+    std::vector<double> err;
+    for (double h : {0.004, 0.002, 0.001}) {
+      const reference_scenes::Run r = RunEngine(s, N, integrator, h, 0, false);
+      ASSERT_TRUE(r.ok) << integrator << " " << h;
+      ASSERT_EQ(r.T.size(), ref.T.size());
+      err.push_back(Rms(r.T, ref.T, from));
+    }
+    const double p1 = std::log2(err[0] / err[1]), p2 = std::log2(err[1] / err[2]);
+    std::printf("%s: error %.4g, %.4g, %.4g N at 4, 2, 1 ms: order %.2f, %.2f\n", integrator,
+                err[0], err[1], err[2], p1, p2);
+    if (std::string(integrator) == "bdf2") {
+      EXPECT_NEAR(p1, 2, 0.4);
+      EXPECT_NEAR(p2, 2, 0.4);
+    } else {
+      EXPECT_LT(p1, 1.3);
+      EXPECT_LT(p2, 1.3);
+    }
+  }
+}
+
+// The issue's wave: a 5 Hz transverse wave at 100 N on a 1 kg/m line (wave speed
+// c = sqrt(T/mu) = 10 m/s) for the 1 s it takes to travel 10 m, at 2 ms. A dry, undamped string
+// of 1 m between fixed ends (stretched to T = 100 N, EA = 1e6 N) in its fundamental
+// (f = c/2L = 5 Hz), 20 segments, plucked to 1 mm at rest in the shape of the discrete mode,
+// sin(pi i/N); no gravity. The exact semi-discrete motion keeps its amplitude (no damping; the
+// axial coupling of a 1 mm pluck changes the tension by 1e-5 relative). Amplitude: at the
+// middle node, sqrt(y^2 + (ydot/omega)^2) with the discrete mode's omega =
+// 2 sqrt(T/(mu L0^2)) sin(pi/(2 N)). BDF2's amplification factor at omega h = 0.063 predicts
+// 0.998 after 500 steps; backward Euler's (1 + (omega h)^2)^(-1/2) predicts 0.37. Asserted:
+// bdf2 >= 0.99 (the issue asks 0.9), backward Euler <= 0.45 (the test's own control).
+TEST(Bdf2, KeepsThe5HzWaveWhereBackwardEulerDampsIt) {
+  const double T = 100, mu = 1, EA = 1e6, L = 1, h = 0.002;
+  const int N = 20;
+  const double span = L * (1 + T / EA);
+  const double L0 = L / N, omega = 2 * std::sqrt(T / (mu * L0 * L0)) * std::sin(kPi / (2 * N));
+  ASSERT_NEAR(omega / (2 * kPi), 5, 0.02);  // [Hz] the discrete fundamental
+  for (const char* integrator : {"bdf2", "implicit"}) {
+    Environment env;
+    env.gravity = Vec3::Zero();
+    DeclarationError e;
+    std::ostringstream decl;
+    decl << "ends=a,b length=" << L << " segments=" << N << " diameter=0.01 mass_per_length="
+         << mu << " EA=" << EA << " integrator=" << integrator;
+    std::optional<TetherDeclaration> d = ParseTether(decl.str(), env, &e);
+    ASSERT_TRUE(d) << e.message;
+    std::string error;
+    std::optional<Tether> t = Tether::Create(d->params, env, &error);
+    ASSERT_TRUE(t) << error;
+    Ends ends;
+    ends.a.pos = Vec3(0, 0, 0);
+    ends.b.pos = Vec3(span, 0, 0);
+    std::vector<double> x(3 * (N + 1)), v(3 * (N + 1), 0.0), work(t->WorkspaceSize());
+    std::vector<double> history(t->HistorySize() + 1, 0.0);
+    for (int i = 0; i <= N; ++i) {
+      x[3 * i] = span * i / N;
+      x[3 * i + 1] = 1e-3 * std::sin(kPi * i / N);
+      x[3 * i + 2] = 0;
+    }
+    const int mid = N / 2;
+    auto amplitude = [&]() {
+      return std::hypot(x[3 * mid + 1], v[3 * mid + 1] / omega);
+    };
+    const double a0 = amplitude();
+    for (int k = 0; k < 500; ++k) {
+      ASSERT_TRUE(t->Advance(x.data(), v.data(), ends, ends, h, work.data(), history.data()).ok);
+    }
+    const double kept = amplitude() / a0;
+    std::printf("%s: %.4f of the amplitude kept after 1 s (10 m of travel)\n", integrator, kept);
+    if (std::string(integrator) == "bdf2") {
+      EXPECT_GE(kept, 0.99);
+      EXPECT_LE(kept, 1.0 + 1e-3);  // and no growth
+    } else {
+      EXPECT_LE(kept, 0.45);
+    }
+  }
+}
+
+// A declaration without `integrator` gets bdf2; `implicit` is still backward Euler by name, and
+// an unknown name lists bdf2 first as the default.
+TEST(Bdf2, IsTheDefaultAndImplicitStaysBackwardEuler) {
+  DeclarationError e;
+  const std::string base = "ends=a,b length=10 segments=10 diameter=0.02 mass_per_length=1 EA=1e5";
+  std::optional<TetherDeclaration> d = ParseTether(base, Environment(), &e);
+  ASSERT_TRUE(d) << e.message;
+  EXPECT_EQ(d->params.integrator, Integrator::kBdf2);
+  EXPECT_STREQ(IntegratorName(d->params.integrator), "bdf2");
+  d = ParseTether(base + " integrator=implicit", Environment(), &e);
+  ASSERT_TRUE(d) << e.message;
+  EXPECT_EQ(d->params.integrator, Integrator::kImplicit);
+  EXPECT_FALSE(ParseTether(base + " integrator=bdf3", Environment(), &e));
+  EXPECT_NE(e.message.find("allowed: bdf2 (default), implicit, implicit2, explicit, rk4"),
+            std::string::npos)
+      << e.message;
+}
+
+std::string DefaultModelWith(const std::string& integrator) {
+  std::ifstream f(std::string(MJTETHER_MODELS_DIR) + "/rov_tether.xml");
+  std::stringstream s;
+  s << f.rdbuf();
+  std::string xml = s.str();
+  const size_t at = xml.find("integrator=implicit");
+  EXPECT_NE(at, std::string::npos);
+  return xml.replace(at, 19, "integrator=" + integrator);
+}
+
+using Bdf2MuJoCo = testing::MuJoCoFixture;
+
+// mj_copyData carries bdf2's history (it is in mjData::userdata): a copy stepped on reproduces
+// the original bit for bit, as does a run after mj_resetData (the default scene: slack and
+// taut segments, seabed, current, a free vehicle). The history is really there: the block is
+// larger than with backward Euler by HistorySize() doubles.
+TEST_F(Bdf2MuJoCo, CopyAndResetAreBitIdentical) {
+  mjModel* m = Load(DefaultModelWith("bdf2"));
+  mjModel* be = Load(DefaultModelWith("implicit"));
+  ASSERT_TRUE(m && be);
+  const Tether* t = GetTether(m, 0);
+  EXPECT_EQ(t->HistorySize(), 1 + 6 * t->nodes());
+  EXPECT_EQ(m->nuserdata - be->nuserdata, t->HistorySize());
+  mjData* d = Make(m);
+  for (int k = 0; k < 250; ++k) mj_step(m, d);
+  mjData* copy = Make(m);
+  mj_copyData(copy, m, d);
+  for (int k = 0; k < 250; ++k) {
+    mj_step(m, d);
+    mj_step(m, copy);
+  }
+  EXPECT_EQ(std::memcmp(d->qpos, copy->qpos, sizeof(mjtNum) * m->nq), 0);
+  EXPECT_EQ(std::memcmp(d->qvel, copy->qvel, sizeof(mjtNum) * m->nv), 0);
+  EXPECT_EQ(std::memcmp(d->userdata, copy->userdata, sizeof(mjtNum) * m->nuserdata), 0);
+
+  mjData* fresh = Make(m);
+  for (int k = 0; k < 200; ++k) mj_step(m, fresh);
+  std::vector<mjtNum> user(fresh->userdata, fresh->userdata + m->nuserdata);
+  mj_resetData(m, fresh);
+  for (int k = 0; k < 200; ++k) mj_step(m, fresh);
+  EXPECT_EQ(std::memcmp(user.data(), fresh->userdata, sizeof(mjtNum) * m->nuserdata), 0);
+  EXPECT_FALSE(CheckDivergence(m, d).has_value());
+}
+
+// A winch with bdf2: the winch tests' hanging weight (tests/winch_test.cc, EveryIntegrator:
+// 10 m, L0 = 1 m, mu = 1 kg/m, EA = 1e6 N, damping 2e3 N s, 50 kg on a slide)
+// settled on its damped slide for 3 s, then free, paid out then hauled in at 0.5 m/s for 6 s
+// each, crossing 2-3 regrids each way (each restarts the
+// scheme with one backward-Euler step). Asserted as there: the deployed length within 1e-9 m
+// of the ramped speed profile's sum, and the drum tension within 0.5% of the static m g +
+// mu g L once the ramp's transient has decayed (from 4 s).
+TEST_F(Bdf2MuJoCo, WinchPayoutAndHaulInWithinTheWinchTolerances) {
+  const double g = 9.81, mass = 50, mu = 1;
+  const std::string xml = R"(<mujoco><option timestep="0.002" gravity="0 0 -9.81"/><custom>
+  <text name="tether:line" data="ends=drum,hook length=10 segments=10 diameter=0.02
+        mass_per_length=1 EA=1e6 damping=2e3 integrator=bdf2"/>
+  <text name="winch:line" data="end=A mode=speed actuator=w min_length=5 max_length=30
+        max_speed=1 max_accel=0.5"/>
+  </custom><worldbody><site name="drum"/>
+  <body name="weight" pos="0 0 -10"><joint name="z" type="slide" axis="0 0 1" damping="4000"/>
+  <geom type="sphere" size="0.1" mass="50"/><site name="hook"/></body>
+  </worldbody><actuator><motor name="w" joint="z" gear="0"/></actuator></mujoco>)";
+  mjModel* m = Load(xml);
+  ASSERT_NE(m, nullptr);
+  mjData* d = Make(m);
+  // Settled on the damped slide for 3 s, then free (as WinchTest::Settle).
+  d->ctrl[0] = 0;
+  while (d->time < 3) mj_step(m, d);
+  m->dof_damping[0] = 0;
+  const double h = m->opt.timestep;
+  for (double v : {0.5, -0.5}) {
+    d->ctrl[0] = v;
+    double L = GetWinch(m, d, 0).length, speed = GetWinch(m, d, 0).payout_speed;
+    const int segments0 = GetWinch(m, d, 0).segments;
+    double worst = 0;
+    for (int k = 0; k < 3000; ++k) {
+      mj_step(m, d);
+      speed = v > speed ? std::min(v, speed + 0.5 * h) : std::max(v, speed - 0.5 * h);
+      L += speed * h;
+      const WinchState w = GetWinch(m, d, 0);
+      ASSERT_NEAR(w.length, L, 1e-9);
+      if (k * h < 4) continue;
+      const double T = GetReactions(m, d, 0).tension_a;
+      const double expected = mass * g + mu * g * w.length;
+      worst = std::max(worst, std::abs(T - expected) / expected);
+    }
+    const int regrids = std::abs(GetWinch(m, d, 0).segments - segments0);
+    std::printf("bdf2 v = %+.1f: %d regrids, tension error %.3g%%\n", v, regrids, 100 * worst);
+    EXPECT_GE(regrids, 2);
+    EXPECT_LE(worst, 0.005) << "v = " << v;
+    ASSERT_FALSE(CheckDivergence(m, d).has_value()) << *CheckDivergence(m, d);
+  }
+}
+
+}  // namespace
+}  // namespace mjtether
