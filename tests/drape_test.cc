@@ -57,8 +57,9 @@ TEST_P(Drape, EquilibriumAsStaticsPredicts) {
   // The MuJoCo step each integrator's coupling limit with the 5 kg mass on the stiff tether
   // (omega = 2000 rad/s) accepts: omega h < 2 explicit, 0.8 rk4, 4 implicit2 (docs/coupling.md).
   // rk4 passes too (T_A 46.574 N for 46.587) but takes 28 600 steps (minutes under load): not
-  // in the suite. implicit2 settles at the right place (x_B, z_B within 0.6 and 5 mm) but its
-  // end reaction reads 24.9 N for 46.6 (docs/contact.md, not a contact matter).
+  // in the suite. implicit2 is refused on this scene (contact with an end on a moving body):
+  // it settled at the right place but its end tensions read 19, 25 and 67 N at 2, 1 and
+  // 0.5 ms for 46.6 N (docs/contact.md).
   const std::string integrator = GetParam();
   const double timestep = integrator == "explicit"    ? 0.0008
                           : integrator == "rk4"       ? 0.00035
