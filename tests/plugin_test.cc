@@ -276,6 +276,39 @@ TEST_F(MuJoCoTest, MotionEndGetsTheExactPrescribedVelocity) {
   EXPECT_LT(worst, 1e-9);
 }
 
+// A strain beyond max_strain is reported as divergence (docs/reference.md, max_strain), at
+// the step it is crossed. A mocap end pulls a soft line (EA 1e3 N, max_strain 0.1) slowly
+// from 10 m to 18 m over 16 s (strain rate 0.05/s: 1e-4 per 2 ms step). The pull starts at
+// 0.5 m/s at once, which sends an axial wave of strain v/c = 0.5/sqrt(EA/mu) = 0.0087 along
+// the line (doubled where it reflects), so a segment can lead the mean strain by up to
+// 0.017: the report must come when the mean strain (end distance / length - 1) is between
+// 0.1 - 0.017 and 0.11, and name max_strain. The mutant that checks 10 max_strain reports
+// nothing below a strain of 1.
+TEST_F(MuJoCoTest, StrainBeyondMaxStrainIsReportedAsItIsCrossed) {
+  mjModel* m = Load(R"(<mujoco><option timestep="0.002" gravity="0 0 0"/><custom>
+      <text name="tether:t" data="ends=anchor,end length=10 segments=10 diameter=0.02
+            mass_per_length=0.3 EA=1e3 damping=10 max_strain=0.1"/></custom>
+      <worldbody><site name="anchor"/>
+        <body name="ship" mocap="true" pos="10 0 0"><site name="end"/></body>
+      </worldbody></mujoco>)");
+  mjData* d = Make(m);
+  double reported_at = -1;
+  std::string message;
+  for (int k = 0; k < 8000 && reported_at < 0; ++k) {
+    d->mocap_pos[0] = 10 + 0.5 * d->time;
+    mj_step(m, d);
+    if (auto e = mjtether::CheckDivergence(m, d)) {
+      reported_at = d->mocap_pos[0] / 10 - 1;
+      message = *e;
+    }
+  }
+  std::printf("strain divergence reported at a mean strain of %.4f: %s\n", reported_at,
+              message.c_str());
+  EXPECT_GE(reported_at, 0.1 - 2 * 0.5 / std::sqrt(1e3 / 0.3));
+  EXPECT_LE(reported_at, 0.11);
+  EXPECT_NE(message.find("max_strain"), std::string::npos) << message;
+}
+
 // MuJoCo's RK4 evaluates the passive force at t + h/2 and t + h with a mocap body still where
 // it was at t (mocap bodies move only between steps). A call that finds the mocap end where
 // the last call left it takes its velocity as zero, as the position says, rather than reading
