@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_shell.h"
 #include "mjtether.h"
 #include "render.h"
 
@@ -26,6 +27,7 @@ namespace mjtether::render {
 namespace {
 
 namespace fs = std::filesystem;
+using mjtether::test_util::Shell;
 
 // Pixel (column, row from the bottom) where world point p projects through a GL camera in a
 // W x H viewport, as mjr_render sets up OpenGL for a mono image: a look-at view from pos along
@@ -262,21 +264,6 @@ TEST(Layout, OverlaysFitAndDrawOnlyInsideTheirRectangles) {
 }
 
 // ---- the command line ----
-
-std::string Shell(const std::string& command, int* status) {
-  std::string out;
-  FILE* p = popen(command.c_str(), "r");
-  if (!p) {
-    *status = -1;
-    return out;
-  }
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof(buf), p)) > 0) out.append(buf, n);
-  const int s = pclose(p);
-  *status = WIFEXITED(s) ? WEXITSTATUS(s) : -1;
-  return out;
-}
 
 class FramingCli : public ::testing::Test {
  protected:
