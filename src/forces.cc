@@ -301,12 +301,11 @@ Tether::ContactEval Tether::ContactForce(const ContactPoint& c, const double* xp
     P0 = -0.5 * ga * s0;
     P1 = -ga * s0 * s0 / 6;
     e.length = s0;
-    // d/dga and d/dgb of P1 = -ga^3/(6 D^2) and of P0 - P1.
-    const double dP0a = -ga * (ga - 2 * gb) / (2 * D * D), dP0b = -ga * ga / (2 * D * D);
+    // d/dga of P0 and of P1 = -ga^3/(6 D^2), d/dgb of P1 (K needs no more).
+    const double dP0a = -ga * (ga - 2 * gb) / (2 * D * D);
     const double dP1a = -ga * ga * (ga - 3 * gb) / (6 * D * D * D),
                  dP1b = -ga * ga * ga / (3 * D * D * D);
     e.K[0] = -(dP0a - dP1a), e.K[1] = -dP1a, e.K[2] = -dP1b;
-    (void)dP0b;
   } else {
     // In contact on [1 - s1, 1], s1 = gb/(gb - ga): mirrored.
     const double D = gb - ga, s1 = gb / D;
