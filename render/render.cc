@@ -685,7 +685,15 @@ void Renderer::ComputeLayout(const mjModel* m) {
   if (vehicle_ >= 0 && opt_.pip_min_px > 0) {
     int h = std::max(H * 3 / 10, 96), w = h * 4 / 3;
     if (w > 2 * W / 5) w = 2 * W / 5, h = w * 3 / 4;
-    l.pip = {pad, pad, w, h};
+    // Bottom left, so beside the colour scale (bottom right) and below the HUD (top left): in a
+    // small frame the scale's panel reaches into the left half (at 320x240 its left edge is at
+    // x = 106, where a 96 px high close-up would end at 130), so the close-up shrinks to fit.
+    const int w_max = l.scale.empty() ? W - 2 * pad : l.scale.x - 2 * pad;
+    const int h_max = l.hud.empty() ? H - 2 * pad : l.hud.y - 2 * pad;
+    if (w > w_max) w = w_max, h = w * 3 / 4;
+    if (h > h_max) h = h_max, w = h * 4 / 3;
+    // Smaller than three lines of text it shows nothing worth a corner: no close-up.
+    if (h >= 3 * ch) l.pip = {pad, pad, w, h};
   }
   layout_ = l;
   layout_dirty_ = false;

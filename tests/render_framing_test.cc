@@ -17,6 +17,7 @@
 #include <memory>
 #include <ostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cli_shell.h"
@@ -194,7 +195,8 @@ INSTANTIATE_TEST_SUITE_P(
     });
 
 // The overlays fit the frame at 320x240 and 1920x1080: the HUD and the colour scale are inside
-// it and apart, the "segment tension [N]" label (its width from MuJoCo's font metrics, as the
+// it and apart, no two overlays (HUD, scale, current arrow, close-up) overlap at 320x240,
+// 640x480 or 1920x1080, the "segment tension [N]" label (its width from MuJoCo's font metrics, as the
 // code draws it) lies inside the scale's panel, and a frame with the HUD differs from one
 // without only inside the HUD's and the scale's rectangles (nothing drawn elsewhere, so
 // nothing cut or overlapping outside them).
@@ -206,7 +208,7 @@ TEST(Layout, OverlaysFitAndDrawOnlyInsideTheirRectangles) {
   mjModel* m = model.get();
   mjData* d = mj_makeData(m);
   mj_forward(m, d);
-  for (const std::array<int, 2> size : {std::array<int, 2>{320, 240}, {1920, 1080}}) {
+  for (const std::array<int, 2> size : {std::array<int, 2>{320, 240}, {640, 480}, {1920, 1080}}) {
     const int W = size[0], H = size[1];
     RenderOptions opt;
     opt.width = W;
@@ -230,6 +232,21 @@ TEST(Layout, OverlaysFitAndDrawOnlyInsideTheirRectangles) {
     EXPECT_FALSE(l.hud.x < l.scale.x + l.scale.w && l.scale.x < l.hud.x + l.hud.w &&
                  l.hud.y < l.scale.y + l.scale.h && l.scale.y < l.hud.y + l.hud.h)
         << at << ": HUD and colour scale overlap";
+    // No two overlays overlap (HUD, colour scale, current arrow, the vehicle close-up when it
+    // is shown: the vehicle of this scene is below the close-up threshold at 320x240).
+    const std::array<std::pair<const char*, Rect>, 4> boxes = {
+        {{"HUD", l.hud}, {"colour scale", l.scale}, {"current arrow", l.arrow}, {"close-up", l.pip}}};
+    for (size_t i = 0; i < boxes.size(); ++i) {
+      const Rect& a = boxes[i].second;
+      if (a.empty()) continue;
+      EXPECT_TRUE(inside(a, frame)) << at << ": " << boxes[i].first << " outside the frame";
+      for (size_t j = i + 1; j < boxes.size(); ++j) {
+        const Rect& b = boxes[j].second;
+        if (b.empty()) continue;
+        EXPECT_FALSE(a.x < b.x + b.w && b.x < a.x + a.w && a.y < b.y + b.h && b.y < a.y + a.h)
+            << at << ": " << boxes[i].first << " and " << boxes[j].first << " overlap";
+      }
+    }
     // The HUD and the scale stay small: the scene keeps most of the frame. MuJoCo 2.2.2's
     // smallest font has 18 px lines (its 50 % scale draws as 100 %), so at 320x240 the HUD's
     // five lines and the scale's three rows take 36 % of the frame (19 % and 16 %; the
@@ -243,7 +260,9 @@ TEST(Layout, OverlaysFitAndDrawOnlyInsideTheirRectangles) {
     bare.hud = false;
     std::unique_ptr<Renderer> r0 = Renderer::Create(m, bare, &error);
     ASSERT_NE(r0, nullptr) << error;
+    r0->NextPose(m, d);  // (decides whether its close-up is shown, as r's did)
     r0->RenderAt(m, d, pose, without.data());
+    const Layout l0 = r0->layout();
     int outside = 0, in_label = 0;
     for (int row = 0; row < H; ++row) {
       for (int col = 0; col < W; ++col) {
@@ -251,7 +270,17 @@ TEST(Layout, OverlaysFitAndDrawOnlyInsideTheirRectangles) {
         const bool changed =
             with[i] != without[i] || with[i + 1] != without[i + 1] || with[i + 2] != without[i + 2];
         const double x = col + 0.5, y = row + 0.5;
-        if (changed && !l.hud.Contains(x, y) && !l.scale.Contains(x, y)) ++outside;
+        // (The close-up is sized to fit beside the HUD and the scale, so without them it may be
+        // larger: its rectangles in both frames are left out.)
+        // Its border is drawn max(1, H/240) px outside the rectangle.
+        const int b = std::max(1, H / 240);
+        auto in_pip = [&](const Rect& p) {
+          return !p.empty() && x >= p.x - b && x <= p.x + p.w + b && y >= p.y - b &&
+                 y <= p.y + p.h + b;
+        };
+        if (changed && !l.hud.Contains(x, y) && !l.scale.Contains(x, y) && !in_pip(l.pip) &&
+            !in_pip(l0.pip))
+          ++outside;
         // Text pixels of the label: near white.
         in_label +=
             l.label.Contains(x, y) && with[i] > 200 && with[i + 1] > 200 && with[i + 2] > 200;
