@@ -29,6 +29,7 @@
 
 #include "mjtether.h"
 #include "render.h"
+#include "render_geometry.h"
 
 namespace mjtether::render {
 namespace {
@@ -83,46 +84,13 @@ struct ModelDeleter {
   }
 };
 
-// Box bounding the projections of the corners of body b's visible geoms (groups 0-2, not
-// transparent) through pose p in a W x H viewport: {xmin, ymin, xmax, ymax}.
+using test_util::ProjectGl;
+
+// Box bounding the projections of body b's visible geoms through pose p in a W x H viewport.
 std::array<double, 4> BodyBox(const mjModel* m, const mjData* d, int b, const CameraPose& p, int W,
                               int H) {
-  std::array<double, 4> box = {1e300, 1e300, -1e300, -1e300};
-  for (int g = 0; g < m->ngeom; ++g) {
-    if (m->geom_bodyid[g] != b || m->geom_group[g] > 2 || m->geom_rgba[4 * g + 3] == 0) continue;
-    const double* s = m->geom_size + 3 * g;
-    double e[3] = {s[0], s[1], s[2]};
-    if (m->geom_type[g] == mjGEOM_SPHERE) e[1] = e[2] = s[0];
-    if (m->geom_type[g] == mjGEOM_CYLINDER) e[1] = s[0], e[2] = s[1];
-    if (m->geom_type[g] == mjGEOM_CAPSULE) e[1] = s[0], e[2] = s[0] + s[1];
-    for (int corner = 0; corner < 8; ++corner) {
-      double local[3], world[3];
-      for (int i = 0; i < 3; ++i) local[i] = (corner >> i & 1 ? 1 : -1) * e[i];
-      mju_rotVecMat(world, local, d->geom_xmat + 9 * g);
-      mju_addTo3(world, d->geom_xpos + 3 * g);
-      const std::array<double, 2> px = ProjectPose(p, m->vis.global.fovy, W, H, world);
-      box[0] = std::min(box[0], px[0]), box[1] = std::min(box[1], px[1]);
-      box[2] = std::max(box[2], px[0]), box[3] = std::max(box[3], px[1]);
-    }
-  }
-  return box;
-}
-
-// Pixel where p projects through the GL camera c in a W x H viewport, as mjr_render sets up
-// OpenGL (look-at from pos along forward with up; frustum at the near plane).
-std::array<double, 2> ProjectGl(const mjvGLCamera& c, int W, int H, const double* p) {
-  double v[3], right[3];
-  for (int i = 0; i < 3; ++i) v[i] = p[i] - c.pos[i];
-  const double f[3] = {c.forward[0], c.forward[1], c.forward[2]};
-  const double u[3] = {c.up[0], c.up[1], c.up[2]};
-  mju_cross(right, f, u);
-  const double z = mju_dot3(v, f);
-  const double xn = c.frustum_near * mju_dot3(v, right) / z;
-  const double yn = c.frustum_near * mju_dot3(v, u) / z;
-  const double half_w = 0.5 * W / H * (c.frustum_top - c.frustum_bottom);
-  const double left = c.frustum_center - half_w;
-  return {W * (xn - left) / (2 * half_w),
-          H * (yn - c.frustum_bottom) / (c.frustum_top - c.frustum_bottom)};
+  return test_util::BodyBox(
+      m, d, b, [&](const double* x) { return ProjectPose(p, m->vis.global.fovy, W, H, x); });
 }
 
 // The largest tension over the frames' instants, rounded up as `render --tension-max auto`

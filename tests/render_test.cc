@@ -18,6 +18,7 @@
 
 #include "cli_shell.h"
 #include "mjtether.h"
+#include "render_geometry.h"
 
 namespace mjtether::render {
 namespace {
@@ -49,26 +50,7 @@ class RenderTest : public ::testing::Test {
   mjData* d_ = nullptr;
 };
 
-// Pixel (column, row from the bottom) where world point p projects through the scene's camera,
-// as mjr_render sets up OpenGL for a mono image: the average of the two eyes' cameras (each is
-// offset by half the inter-pupillary distance), a look-at view from pos along forward with up,
-// and a frustum [center -/+ half width] x [bottom, top] at the near plane, its width from the
-// aspect ratio.
-std::array<double, 2> Project(const mjvScene& scn, int W, int H, const double* p) {
-  const mjvGLCamera c = mjv_averageCamera(&scn.camera[0], &scn.camera[1]);
-  double v[3], right[3];
-  for (int i = 0; i < 3; ++i) v[i] = p[i] - c.pos[i];
-  const double f[3] = {c.forward[0], c.forward[1], c.forward[2]};
-  const double u[3] = {c.up[0], c.up[1], c.up[2]};
-  mju_cross(right, f, u);
-  const double z = mju_dot3(v, f);
-  const double xn = c.frustum_near * mju_dot3(v, right) / z;
-  const double yn = c.frustum_near * mju_dot3(v, u) / z;
-  const double half_w = 0.5 * W / H * (c.frustum_top - c.frustum_bottom);
-  const double left = c.frustum_center - half_w;
-  return {W * (xn - left) / (2 * half_w),
-          H * (yn - c.frustum_bottom) / (c.frustum_top - c.frustum_bottom)};
-}
+constexpr auto Project = test_util::ProjectScene;
 
 TEST_F(RenderTest, TetherPixelsAppearWhereTheNodesProjectInTheirTensionColour) {
   Load(kTwoTethers);

@@ -21,6 +21,7 @@
 #include "cli_shell.h"
 #include "mjtether.h"
 #include "render.h"
+#include "render_geometry.h"
 
 namespace mjtether::render {
 namespace {
@@ -46,23 +47,7 @@ std::vector<unsigned char> ReadPng(const std::string& path, int* w, int* h) {
   return rgb;
 }
 
-// As render_test.cc: pixel (column, row from the bottom) where p projects through the scene's
-// camera (the average of the two eyes', a frustum from the aspect ratio).
-std::array<double, 2> Project(const mjvScene& scn, int W, int H, const double* p) {
-  const mjvGLCamera c = mjv_averageCamera(&scn.camera[0], &scn.camera[1]);
-  double v[3], right[3];
-  for (int i = 0; i < 3; ++i) v[i] = p[i] - c.pos[i];
-  const double f[3] = {c.forward[0], c.forward[1], c.forward[2]};
-  const double u[3] = {c.up[0], c.up[1], c.up[2]};
-  mju_cross(right, f, u);
-  const double z = mju_dot3(v, f);
-  const double xn = c.frustum_near * mju_dot3(v, right) / z;
-  const double yn = c.frustum_near * mju_dot3(v, u) / z;
-  const double half_w = 0.5 * W / H * (c.frustum_top - c.frustum_bottom);
-  const double left = c.frustum_center - half_w;
-  return {W * (xn - left) / (2 * half_w),
-          H * (yn - c.frustum_bottom) / (c.frustum_top - c.frustum_bottom)};
-}
+constexpr auto Project = test_util::ProjectScene;
 
 class Viewer : public ::testing::Test {
  protected:
