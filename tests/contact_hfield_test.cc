@@ -321,14 +321,14 @@ TEST_P(HfieldRidge, RestsOnTheRidge) {
   const double w = std::abs(tether->node_weight(N / 2).z()) / L0;  // [N/m] net weight
   const double r = 0.01;
   // The surface's largest curvature |z''| (the crest's, H/sigma^2/(1 - e0)). A segment's plane
-  // is lifted over the surface at its samples (every quarter cell, 1.25 cm): between two
-  // samples the surface may rise above it by |z''| (cell/4)^2/8 (the discretisation asserted).
+  // is lifted over the surface at its samples (every half cell, 2.5 cm): between two samples
+  // the surface may rise above it by |z''| (cell/2)^2/8 (the discretisation asserted).
   double curv = 0;
   for (double xs = -rx; xs <= rx; xs += 1e-3) {
     const double q = xs * xs / (2 * sigma * sigma);
     curv = std::max(curv, std::abs(H / (1 - e0) * (2 * q - 1) / (sigma * sigma) * std::exp(-q)));
   }
-  const double spacing = 0.25 * 2 * rx / 120;  // [m] a quarter cell
+  const double spacing = 0.5 * 2 * rx / 120;  // [m] half a cell
   const double geometric = curv * spacing * spacing / 8;
   // Exact surface height and the depth of a point below the tether's surface (its axis r above
   // the ridge), measured vertically (the slope under the tether is at most 0.3: the normal
