@@ -298,7 +298,7 @@ bool HfieldSegment(const ContactGeom& cg, const Vec3& a, const Vec3& b, double L
   // Samples from the rest length (not the current span), so that their number does not jump.
   const double cell = std::min(2 * h.rx / (h.ncol - 1), 2 * h.ry / (h.nrow - 1));
   const int n = std::clamp(static_cast<int>(std::ceil((hi - lo) * L0 / (0.5 * cell))), 1, 64);
-  Vec3 S0, S1, mean = Vec3::Zero();
+  Vec3 S0 = Vec3::Zero(), S1 = Vec3::Zero(), mean = Vec3::Zero();
   int count = 0;
   auto sample = [&](int k, Vec3* q, Vec3* surface, Vec3* normal) {
     *q = a + (lo + (hi - lo) * k / n) * d;
@@ -507,6 +507,14 @@ int FindContacts(const mjModel* m, const mjData* d, const TetherContacts& tc, co
   double vmax = 0;
   for (int i = 0; i <= N; ++i) vmax = std::max(vmax, v.col(i).norm());
   const double reach = r + 2 * dt * vmax + 1e-3 * L0;
+  // How far ahead the planes of curved geoms are found: the step's end, where the
+  // backward-Euler family (implicit, bdf2, implicit2) evaluates the contact force. The explicit
+  // ones (explicit, rk4) evaluate it through the step and keep the planes of its start (their
+  // middle of the step cancelled their drag too, but with friction the wrap's kinetic energy
+  // rose 2.4x and its mu_eff fell 3 %: docs/contact.md, "Frozen planes").
+  const Integrator integrator = tether.params().integrator;
+  const double ahead =
+      integrator == Integrator::kExplicit || integrator == Integrator::kRK4 ? 0.0 : dt;
   int count = 0;
   *dropped = 0;
   // Boxes of 8 segments (lo, hi: 6 doubles each) and of the whole tether, once per call.
@@ -583,6 +591,11 @@ int FindContacts(const mjModel* m, const mjData* d, const TetherContacts& tc, co
         }
         // Narrow phase in the geom's frame.
         const Vec3 la = R.transpose() * (a - pos), lb = R.transpose() * (b - pos);
+        // The plane of a curved geom is found where the segment will be, relative to the
+        // body, when the integrator evaluates the force (docs/contact.md, "Frozen planes").
+        const Vec3 pa = R.transpose() * (a + ahead * (Vec3(v.col(j)) - vg - w.cross(a - pos)) - pos),
+                   pb = R.transpose() *
+                        (b + ahead * (Vec3(v.col(j + 1)) - vg - w.cross(b - pos)) - pos);
         Closest c;
         if (hfield) {
           // The segment's box against the field's, in its frame, first.
@@ -591,10 +604,13 @@ int FindContacts(const mjModel* m, const mjData* d, const TetherContacts& tc, co
                   .any()) {
             continue;
           }
-          if (!HfieldSegment(cg, la, lb, L0, &c)) continue;
+          if (!HfieldSegment(cg, pa, pb, L0, &c)) continue;
         } else {
-          c = SegmentGeom(type, sz, &cg.hull, la, lb);
+          c = SegmentGeom(type, sz, &cg.hull, plane ? la : pa, plane ? lb : pb);
         }
+        // The gap of the segment as it is against that plane (linear along it: its lower
+        // end's); a supporting plane of a convex geom is never farther than the geom.
+        if (!plane) c.dist = std::min(c.normal.dot(la - c.surface), c.normal.dot(lb - c.surface));
         if (!(c.dist < margin)) continue;
         if (count == capacity) {
           ++*dropped;
