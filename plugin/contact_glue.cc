@@ -473,6 +473,44 @@ bool ResolveContactGeoms(const mjModel* m, const std::string& spec, const int si
       cg.hfield_rbound = Vec3(cg.hfield.rx, cg.hfield.ry,
                               std::max(cg.hfield_top, cg.hfield_base)).norm();
     }
+    {
+      // The geom's thinnest half-size: the radius (and a cylinder's half-length), a box's
+      // or an ellipsoid's smallest half-size, a mesh hull's depth from its corners' centroid
+      // to its nearest face, a height field's smaller cell.
+      const double* sz = m->geom_size + 3 * g;
+      double thin = 0;
+      switch (m->geom_type[g]) {
+        case mjGEOM_SPHERE:
+        case mjGEOM_CAPSULE:
+          thin = sz[0];
+          break;
+        case mjGEOM_CYLINDER:
+          thin = std::min(sz[0], sz[1]);
+          break;
+        case mjGEOM_BOX:
+        case mjGEOM_ELLIPSOID:
+          thin = std::min({sz[0], sz[1], sz[2]});
+          break;
+        case mjGEOM_MESH: {
+          Vec3 c = Vec3::Zero();
+          for (const Vec3& p : cg.hull.corner) c += p;
+          c /= std::max<size_t>(1, cg.hull.corner.size());
+          thin = INFINITY;
+          for (size_t f = 0; f < cg.hull.normal.size(); ++f) {
+            thin = std::min(thin, cg.hull.offset[f] - cg.hull.normal[f].dot(c));
+          }
+          thin = std::isfinite(thin) ? std::max(thin, 0.0) : 0;
+          break;
+        }
+        case mjGEOM_HFIELD:
+          thin = std::min(2 * cg.hfield.rx / (cg.hfield.ncol - 1),
+                          2 * cg.hfield.ry / (cg.hfield.nrow - 1));
+          break;
+        default:
+          break;
+      }
+      cg.max_ahead = 0.25 * thin;
+    }
     // A geom on an end's body is that end's own when the site is inside it or within
     // rho = L0 + d of its surface (the tether starts against it): its segments skip it over the
     // arc that leaves it, the site's depth in it plus rho. Other geoms of that body (a part of
@@ -593,9 +631,14 @@ int FindContacts(const mjModel* m, const mjData* d, const TetherContacts& tc, co
         const Vec3 la = R.transpose() * (a - pos), lb = R.transpose() * (b - pos);
         // The plane of a curved geom is found where the segment will be, relative to the
         // body, when the integrator evaluates the force (docs/contact.md, "Frozen planes").
-        const Vec3 pa = R.transpose() * (a + ahead * (Vec3(v.col(j)) - vg - w.cross(a - pos)) - pos),
-                   pb = R.transpose() *
-                        (b + ahead * (Vec3(v.col(j + 1)) - vg - w.cross(b - pos)) - pos);
+        // At most cg.max_ahead, so that a fast segment's prediction does not cross the geom.
+        auto ahead_of = [&](const Vec3& p, const Vec3& vp) {
+          Vec3 step = ahead * (vp - vg - w.cross(p - pos));
+          const double len = step.norm();
+          if (len > cg.max_ahead) step *= cg.max_ahead / len;
+          return Vec3(R.transpose() * (p + step - pos));
+        };
+        const Vec3 pa = ahead_of(a, v.col(j)), pb = ahead_of(b, v.col(j + 1));
         Closest c;
         if (hfield) {
           // The segment's box against the field's, in its frame, first.

@@ -35,6 +35,10 @@ struct ContactGeom {
   // geom_rbound is 0 for hfields).
   SeabedSurface hfield;
   double hfield_base = 0, hfield_top = 0, hfield_rbound = 0;
+  // [m] the most a segment's predicted displacement may move it relative to the geom when its
+  // plane is found ahead (FindContacts): a quarter of the geom's thinnest half-size, so that
+  // a fast segment's prediction does not cross the geom's middle and flip the plane.
+  double max_ahead = 0;
 };
 
 struct TetherContacts {
