@@ -3,7 +3,8 @@
 // Geometry is our own: the closest point between a segment (the tether's axis) and a geom,
 // in the geom's frame, from closed forms for plane, sphere and capsule, and for box, cylinder
 // and ellipsoid from a golden-section search along the segment of the geom's signed distance
-// (convex along a line for a convex body, so the search finds the minimum). Why not
+// (convex along a line for a convex body, so the search finds the minimum); a height field's
+// top surface gives one plane per segment from the triangles under it (HfieldSegment). Why not
 // mjCOLLISIONFUNC: it needs geoms of the model for the segments, and returns nothing beyond
 // its margin or for a segment deep inside; why not libccd/libfcl: a conversion per segment per
 // step for shapes that have closed forms. See docs/contact.md.
