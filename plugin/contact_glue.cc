@@ -3,7 +3,8 @@
 // Geometry is our own: the closest point between a segment (the tether's axis) and a geom,
 // in the geom's frame, from closed forms for plane, sphere and capsule, and for box, cylinder
 // and ellipsoid from a golden-section search along the segment of the geom's signed distance
-// (convex along a line for a convex body, so the search finds the minimum). Why not
+// (convex along a line for a convex body, so the search finds the minimum); a height field's
+// top surface gives one plane per segment from the triangles under it (HfieldSegment). Why not
 // mjCOLLISIONFUNC: it needs geoms of the model for the segments, and returns nothing beyond
 // its margin or for a segment deep inside; why not libccd/libfcl: a conversion per segment per
 // step for shapes that have closed forms. See docs/contact.md.
@@ -15,6 +16,7 @@
 #include <new>
 #include <sstream>
 
+#include "environment_glue.h"
 #include "vehicle_glue.h"
 
 namespace mjtether {
@@ -30,7 +32,7 @@ constexpr int kGoldenIterations = 40;
 bool Supported(int type) {
   return type == mjGEOM_PLANE || type == mjGEOM_SPHERE || type == mjGEOM_CAPSULE ||
          type == mjGEOM_CYLINDER || type == mjGEOM_BOX || type == mjGEOM_ELLIPSOID ||
-         type == mjGEOM_MESH;
+         type == mjGEOM_MESH || type == mjGEOM_HFIELD;
 }
 
 const char* TypeName(int type) {
@@ -122,9 +124,28 @@ Vec3 Normal(int type, const double* sz, const ConvexHull* hull, const Vec3& p) {
   return n > 0 ? Vec3(g / n) : Vec3::UnitZ();
 }
 
+// Height field (geom frame): distance of the local point p above the plane of the surface's
+// triangle under it, (z - zs) n_z (docs/environment.md), and that triangle's upward normal;
+// false if p is outside the field's footprint or below its base (no surface under it: the
+// field is a finite block, its sides are not modelled).
+bool HfieldGap(const ContactGeom& cg, const Vec3& p, double* gap, Vec3* normal) {
+  const SeabedSurface& h = cg.hfield;
+  if (std::abs(p.x()) > h.rx || std::abs(p.y()) > h.ry || p.z() < -cg.hfield_base) return false;
+  double zs;
+  h.Under(p.x(), p.y(), &zs, normal);
+  *gap = (p.z() - zs) * normal->z();
+  return true;
+}
+
 // Signed distance of the local point p to any supported geom (plane: its side z).
-double PointDistance(int type, const double* sz, const ConvexHull* hull, const Vec3& p) {
+double PointDistance(int type, const double* sz, const ContactGeom& cg, const Vec3& p) {
+  const ConvexHull* hull = &cg.hull;
   switch (type) {
+    case mjGEOM_HFIELD: {
+      double gap;
+      Vec3 n;
+      return HfieldGap(cg, p, &gap, &n) ? gap : INFINITY;
+    }
     case mjGEOM_PLANE:
       return p.z();
     case mjGEOM_SPHERE:
@@ -247,6 +268,85 @@ Closest SegmentGeom(int type, const double* sz, const ConvexHull* hull, const Ve
   return c;
 }
 
+// Height field: one plane for the local segment [a, b] (docs/contact.md, "Height fields").
+// The surface under the part of the segment above the field's footprint is sampled at half the
+// smaller cell size (at most 65 samples, both ends of that part included; the triangle under
+// each sample, HfieldGap). The plane contains the secant between the surface points under the
+// two ends of that part, S0 and S1, tilted across it as the samples' mean normal, and is lifted
+// along its normal until no sample of the surface is above it: on a ramp it is the ramp; in a
+// hollow the nodes' gaps are the surface's; over a crest it is the plane a straight segment
+// rests on. It moves continuously with the nodes (no switching between triangles, which made a
+// tether resting on a curved field chatter). Returns the plane's point and normal, the sample
+// whose axis point is lowest against it and that gap; false if no part of the segment is over
+// the field.
+bool HfieldSegment(const ContactGeom& cg, const Vec3& a, const Vec3& b, double L0, Closest* c) {
+  const SeabedSurface& h = cg.hfield;
+  // The segment's parameter range over the footprint |x| <= rx, |y| <= ry (slab clipping).
+  double lo = 0, hi = 1;
+  const Vec3 d = b - a;
+  const double half[2] = {h.rx, h.ry};
+  for (int k = 0; k < 2; ++k) {
+    if (d[k] == 0) {
+      if (std::abs(a[k]) > half[k]) return false;
+      continue;
+    }
+    double t0 = (-half[k] - a[k]) / d[k], t1 = (half[k] - a[k]) / d[k];
+    if (t0 > t1) std::swap(t0, t1);
+    lo = std::max(lo, t0);
+    hi = std::min(hi, t1);
+  }
+  if (!(lo <= hi)) return false;
+  // Samples from the rest length (not the current span), so that their number does not jump.
+  const double cell = std::min(2 * h.rx / (h.ncol - 1), 2 * h.ry / (h.nrow - 1));
+  const int n = std::clamp(static_cast<int>(std::ceil((hi - lo) * L0 / (0.5 * cell))), 1, 64);
+  Vec3 S0 = Vec3::Zero(), S1 = Vec3::Zero(), mean = Vec3::Zero();
+  int count = 0;
+  auto sample = [&](int k, Vec3* q, Vec3* surface, Vec3* normal) {
+    *q = a + (lo + (hi - lo) * k / n) * d;
+    double gap;
+    if (!HfieldGap(cg, *q, &gap, normal)) return false;
+    *surface = Vec3(q->x(), q->y(), q->z() - gap / normal->z());
+    return true;
+  };
+  for (int k = 0; k <= n; ++k) {
+    Vec3 q, S, normal;
+    if (!sample(k, &q, &S, &normal)) continue;
+    if (count++ == 0) S0 = S;
+    S1 = S;
+    mean += normal;
+  }
+  if (count == 0) return false;
+  // The plane's normal: the mean normal without its component along the secant.
+  Vec3 nrm = mean.normalized();
+  const Vec3 t = S1 - S0;
+  if (t.squaredNorm() > 1e-24) {
+    const Vec3 th = t.normalized();
+    const Vec3 across = nrm - nrm.dot(th) * th;
+    if (across.z() > 0 && across.norm() > 1e-6) nrm = across.normalized();
+  }
+  // Lifted over every sample of the surface; the lowest axis point against it.
+  double lift = 0;
+  c->dist = INFINITY;
+  for (int pass = 0; pass < 2; ++pass) {
+    for (int k = 0; k <= n; ++k) {
+      Vec3 q, S, normal;
+      if (!sample(k, &q, &S, &normal)) continue;
+      if (pass == 0) {
+        lift = std::max(lift, nrm.dot(S - S0));
+      } else {
+        const double gap = nrm.dot(q - S0) - lift;
+        if (gap < c->dist) {
+          c->dist = gap;
+          c->s = lo + (hi - lo) * k / n;
+          c->surface = q - gap * nrm;
+        }
+      }
+    }
+  }
+  c->normal = nrm;
+  return true;
+}
+
 // The convex hull of mesh `mesh` in its geom's frame (MuJoCo stores a mesh's vertices in
 // the frame of its inertia, which is the geom's). Its triangles from the convex graph MuJoCo
 // keeps for collisions (mesh_graph: numvert, numface, vert_edgeadr[numvert],
@@ -293,10 +393,14 @@ bool ResolveContactGeoms(const mjModel* m, const std::string& spec, const int si
                          const Tether& tether, TetherContacts* out,
                          std::vector<std::string>* warnings, std::string* error) {
   std::vector<int> geoms;
+  // The seabed geom (seabed=GEOMNAME) has the seabed's force already.
+  const std::string& seabed_name = tether.env().water.seabed_geom;
+  const int seabed = seabed_name.empty() ? -1 : mj_name2id(m, mjOBJ_GEOM, seabed_name.c_str());
   if (spec == "all") {
     // Every geom that would collide with a geom of contype 1 and conaffinity 1.
     for (int g = 0; g < m->ngeom; ++g) {
       if (!((m->geom_contype[g] & 1) || (m->geom_conaffinity[g] & 1))) continue;
+      if (g == seabed) continue;
       if (!Supported(m->geom_type[g])) {
         const char* name = m->names + m->name_geomadr[g];
         std::ostringstream s;
@@ -319,15 +423,24 @@ bool ResolveContactGeoms(const mjModel* m, const std::string& spec, const int si
         return false;
       }
       if (g >= 0) {
+        if (g == seabed) {
+          *error = "key 'contact': geom '" + name +
+                   "' is the seabed (seabed=" + name +
+                   " in <text name=\"water\">), which the seabed force already acts on; "
+                   "leave it out";
+          return false;
+        }
         if (!Supported(m->geom_type[g])) {
           *error = "key 'contact': geom '" + name + "' is a " + TypeName(m->geom_type[g]) +
-                   "; supported: plane, sphere, capsule, cylinder, box, ellipsoid, mesh";
+                   "; supported: plane, sphere, capsule, cylinder, box, ellipsoid, mesh, "
+                   "hfield";
           return false;
         }
         geoms.push_back(g);
       } else {
         for (int k = 0; k < m->body_geomnum[b]; ++k) {
           const int gk = m->body_geomadr[b] + k;
+          if (gk == seabed) continue;
           if (Supported(m->geom_type[gk])) {
             geoms.push_back(gk);
           } else {
@@ -347,6 +460,58 @@ bool ResolveContactGeoms(const mjModel* m, const std::string& spec, const int si
     ContactGeom cg;
     cg.geom = g;
     if (m->geom_type[g] == mjGEOM_MESH) MakeHull(m, m->geom_dataid[g], &cg.hull);
+    if (m->geom_type[g] == mjGEOM_HFIELD) {
+      const int h = m->geom_dataid[g];
+      if (!HfieldSurface(m, h, &cg.hfield)) {
+        const char* gname = m->names + m->name_geomadr[g];
+        *error = "key 'contact': hfield geom '" +
+                 std::string(gname[0] ? gname : std::to_string(g)) +
+                 "' has fewer than 2 x 2 heights";
+        return false;
+      }
+      cg.hfield_base = m->hfield_size[4 * h + 3];
+      cg.hfield_top = m->hfield_size[4 * h + 2];
+      cg.hfield_rbound = Vec3(cg.hfield.rx, cg.hfield.ry,
+                              std::max(cg.hfield_top, cg.hfield_base)).norm();
+    }
+    {
+      // The geom's thinnest half-size: the radius (and a cylinder's half-length), a box's
+      // or an ellipsoid's smallest half-size, a mesh hull's depth from its corners' centroid
+      // to its nearest face, a height field's smaller cell.
+      const double* sz = m->geom_size + 3 * g;
+      double thin = 0;
+      switch (m->geom_type[g]) {
+        case mjGEOM_SPHERE:
+        case mjGEOM_CAPSULE:
+          thin = sz[0];
+          break;
+        case mjGEOM_CYLINDER:
+          thin = std::min(sz[0], sz[1]);
+          break;
+        case mjGEOM_BOX:
+        case mjGEOM_ELLIPSOID:
+          thin = std::min({sz[0], sz[1], sz[2]});
+          break;
+        case mjGEOM_MESH: {
+          Vec3 c = Vec3::Zero();
+          for (const Vec3& p : cg.hull.corner) c += p;
+          c /= std::max<size_t>(1, cg.hull.corner.size());
+          thin = INFINITY;
+          for (size_t f = 0; f < cg.hull.normal.size(); ++f) {
+            thin = std::min(thin, cg.hull.offset[f] - cg.hull.normal[f].dot(c));
+          }
+          thin = std::isfinite(thin) ? std::max(thin, 0.0) : 0;
+          break;
+        }
+        case mjGEOM_HFIELD:
+          thin = std::min(2 * cg.hfield.rx / (cg.hfield.ncol - 1),
+                          2 * cg.hfield.ry / (cg.hfield.nrow - 1));
+          break;
+        default:
+          break;
+      }
+      cg.max_ahead = 0.25 * thin;
+    }
     // A geom on an end's body is that end's own when the site is inside it or within
     // rho = L0 + d of its surface (the tether starts against it): its segments skip it over the
     // arc that leaves it, the site's depth in it plus rho. Other geoms of that body (a part of
@@ -360,14 +525,13 @@ bool ResolveContactGeoms(const mjModel* m, const std::string& spec, const int si
       mju_sub3(rel, m->site_pos + 3 * s, m->geom_pos + 3 * g);
       mju_negQuat(qinv, m->geom_quat + 4 * g);
       mju_rotVecQuat(local, rel, qinv);
-      const double depth = -PointDistance(m->geom_type[g], m->geom_size + 3 * g, &cg.hull,
+      const double depth = -PointDistance(m->geom_type[g], m->geom_size + 3 * g, cg,
                                           Vec3(local[0], local[1], local[2]));
       if (depth > -rho) cg.skip[end] = std::max(0.0, depth) + rho;
     }
     out->geoms.push_back(cg);
   }
   out->capacity = 4 * tether.segments() + 16;
-  (void)error;
   return true;
 }
 
@@ -382,6 +546,14 @@ int FindContacts(const mjModel* m, const mjData* d, const TetherContacts& tc, co
   double vmax = 0;
   for (int i = 0; i <= N; ++i) vmax = std::max(vmax, v.col(i).norm());
   const double reach = r + 2 * dt * vmax + 1e-3 * L0;
+  // How far ahead the planes of curved geoms are found: the step's end, where the
+  // backward-Euler family (implicit, bdf2, implicit2) evaluates the contact force. The explicit
+  // ones (explicit, rk4) evaluate it through the step and keep the planes of its start (their
+  // middle of the step cancelled their drag too, but with friction the wrap's kinetic energy
+  // rose 2.4x and its mu_eff fell 3 %: docs/contact.md, "Frozen planes").
+  const Integrator integrator = tether.params().integrator;
+  const double ahead =
+      integrator == Integrator::kExplicit || integrator == Integrator::kRK4 ? 0.0 : dt;
   int count = 0;
   *dropped = 0;
   // Boxes of 8 segments (lo, hi: 6 doubles each) and of the whole tether, once per call.
@@ -418,9 +590,24 @@ int FindContacts(const mjModel* m, const mjData* d, const TetherContacts& tc, co
       w = Vec3(twist[0], twist[1], twist[2]);
       vg = Vec3(twist[3], twist[4], twist[5]);
     }
-    const double margin = reach + 2 * dt * (vg.norm() + w.norm() * m->geom_rbound[g]);
-    const double bound = m->geom_rbound[g] + margin;
-    if (!plane && apart(pos, all_lo, all_hi, bound)) continue;
+    // MuJoCo gives an hfield no bounding radius (0): ours, and its box in its frame
+    // (footprint, base to top), which is the broad phase of an hfield instead of the sphere.
+    const bool hfield = type == mjGEOM_HFIELD;
+    const double rbound = hfield ? cg.hfield_rbound : m->geom_rbound[g];
+    const double margin = reach + 2 * dt * (vg.norm() + w.norm() * rbound);
+    const double bound = rbound + margin;
+    const Vec3 field_lo(-cg.hfield.rx - margin, -cg.hfield.ry - margin, -cg.hfield_base - margin),
+        field_hi(cg.hfield.rx + margin, cg.hfield.ry + margin, cg.hfield_top + margin);
+    // A world box (lo, hi) is apart from the field's box: its box in the field's frame
+    // (centre R^T (c - pos), half sizes |R^T| e) does not overlap.
+    auto off_field = [&](const Vec3& lo, const Vec3& hi) {
+      const Vec3 c = R.transpose() * (0.5 * (lo + hi) - pos);
+      const Vec3 e = R.transpose().cwiseAbs() * (0.5 * (hi - lo));
+      return ((c + e).array() < field_lo.array() || (c - e).array() > field_hi.array()).any();
+    };
+    if (hfield ? off_field(all_lo, all_hi) : !plane && apart(pos, all_lo, all_hi, bound)) {
+      continue;
+    }
     for (int c0 = 0; c0 < N; c0 += kChunk) {
       const int c1 = std::min(N, c0 + kChunk);
       const double* box = boxes + 6 * (c0 / kChunk);
@@ -431,18 +618,43 @@ int FindContacts(const mjModel* m, const mjData* d, const TetherContacts& tc, co
         double lowest = INFINITY;
         for (int i = c0; i <= c1; ++i) lowest = std::min(lowest, nrm.dot(x.col(i) - pos));
         if (lowest > margin) continue;
-      } else if (apart(pos, Vec3(box), Vec3(box + 3), bound)) {
+      } else if (hfield ? off_field(Vec3(box), Vec3(box + 3))
+                        : apart(pos, Vec3(box), Vec3(box + 3), bound)) {
         continue;
       }
       for (int j = c0; j < c1; ++j) {
         if (j * L0 < cg.skip[0] || (N - j - 1) * L0 < cg.skip[1]) continue;
         const Vec3 a = x.col(j), b = x.col(j + 1);
-        if (!plane) {
+        if (!plane && !hfield) {
           if (apart(pos, a.cwiseMin(b), a.cwiseMax(b), bound)) continue;
         }
         // Narrow phase in the geom's frame.
-        const Closest c =
-            SegmentGeom(type, sz, &cg.hull, R.transpose() * (a - pos), R.transpose() * (b - pos));
+        const Vec3 la = R.transpose() * (a - pos), lb = R.transpose() * (b - pos);
+        // The plane of a curved geom is found where the segment will be, relative to the
+        // body, when the integrator evaluates the force (docs/contact.md, "Frozen planes").
+        // At most cg.max_ahead, so that a fast segment's prediction does not cross the geom.
+        auto ahead_of = [&](const Vec3& p, const Vec3& vp) {
+          Vec3 step = ahead * (vp - vg - w.cross(p - pos));
+          const double len = step.norm();
+          if (len > cg.max_ahead) step *= cg.max_ahead / len;
+          return Vec3(R.transpose() * (p + step - pos));
+        };
+        const Vec3 pa = ahead_of(a, v.col(j)), pb = ahead_of(b, v.col(j + 1));
+        Closest c;
+        if (hfield) {
+          // The segment's box against the field's, in its frame, first.
+          if (((la.cwiseMax(lb).array() < field_lo.array()) ||
+               (la.cwiseMin(lb).array() > field_hi.array()))
+                  .any()) {
+            continue;
+          }
+          if (!HfieldSegment(cg, pa, pb, L0, &c)) continue;
+        } else {
+          c = SegmentGeom(type, sz, &cg.hull, plane ? la : pa, plane ? lb : pb);
+        }
+        // The gap of the segment as it is against that plane (linear along it: its lower
+        // end's); a supporting plane of a convex geom is never farther than the geom.
+        if (!plane) c.dist = std::min(c.normal.dot(la - c.surface), c.normal.dot(lb - c.surface));
         if (!(c.dist < margin)) continue;
         if (count == capacity) {
           ++*dropped;

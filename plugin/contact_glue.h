@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "contact.h"
+#include "seabed.h"
 #include "tether.h"
 
 namespace mjtether {
@@ -28,6 +29,16 @@ struct ContactGeom {
   int geom = -1;
   double skip[2] = {0, 0};
   ConvexHull hull;  // mesh geoms only
+  // Height-field geoms only: the surface in the geom's frame (environment_glue.h,
+  // HfieldSurface), its base depth below the origin and its top above it [m] (MuJoCo's
+  // hfield size[3] and size[2]), and a bounding radius about the origin [m] (MuJoCo's
+  // geom_rbound is 0 for hfields).
+  SeabedSurface hfield;
+  double hfield_base = 0, hfield_top = 0, hfield_rbound = 0;
+  // [m] the most a segment's predicted displacement may move it relative to the geom when its
+  // plane is found ahead (FindContacts): a quarter of the geom's thinnest half-size, so that
+  // a fast segment's prediction does not cross the geom's middle and flip the plane.
+  double max_ahead = 0;
 };
 
 struct TetherContacts {
@@ -37,7 +48,8 @@ struct TetherContacts {
 
 // Resolves `contact=` ("all" or geom/body names) for a tether whose end sites are site[0],
 // site[1] (-1: free). Supported geom types: plane, sphere, capsule, cylinder, box, ellipsoid,
-// mesh (its convex hull). A named hfield is an error; under `all` it is left out with a warning.
+// mesh (its convex hull), hfield (its top surface). The seabed geom (seabed=GEOMNAME) is left
+// out of `all` and an error when named (the seabed force already acts on it).
 bool ResolveContactGeoms(const mjModel* m, const std::string& spec, const int site[2],
                          const Tether& tether, TetherContacts* out,
                          std::vector<std::string>* warnings, std::string* error);

@@ -52,23 +52,35 @@ bool SeabedFromGeom(const mjModel* m, Water* w, std::string* error) {
   if (!(ez.z() >= 1 - 1e-9)) {
     return fail("an hfield seabed may be turned about z only (its z axis vertical)");
   }
-  const int h = m->geom_dataid[g];
-  s.kind = SeabedSurface::Kind::kHfield;
+  if (!HfieldSurface(m, m->geom_dataid[g], &s)) {
+    return fail("the hfield needs at least 2 x 2 heights");
+  }
+  s.point = pos;
   s.cos_yaw = ex.x() / std::hypot(ex.x(), ex.y());
   s.sin_yaw = ex.y() / std::hypot(ex.x(), ex.y());
-  s.rx = m->hfield_size[4 * h];
-  s.ry = m->hfield_size[4 * h + 1];
-  s.nrow = m->hfield_nrow[h];
-  s.ncol = m->hfield_ncol[h];
-  if (s.nrow < 2 || s.ncol < 2) return fail("the hfield needs at least 2 x 2 heights");
-  // MuJoCo's heights are normalised to [0, 1] and scaled by the elevation size[2].
-  const float* data = m->hfield_data + m->hfield_adr[h];
-  s.height.resize(static_cast<size_t>(s.nrow) * s.ncol);
-  for (size_t i = 0; i < s.height.size(); ++i) s.height[i] = data[i] * m->hfield_size[4 * h + 2];
   return true;
 }
 
 }  // namespace
+
+bool HfieldSurface(const mjModel* m, int h, SeabedSurface* s) {
+  s->kind = SeabedSurface::Kind::kHfield;
+  s->point.setZero();
+  s->cos_yaw = 1;
+  s->sin_yaw = 0;
+  s->rx = m->hfield_size[4 * h];
+  s->ry = m->hfield_size[4 * h + 1];
+  s->nrow = m->hfield_nrow[h];
+  s->ncol = m->hfield_ncol[h];
+  if (s->nrow < 2 || s->ncol < 2) return false;
+  // MuJoCo's heights are normalised to [0, 1] and scaled by the elevation size[2].
+  const float* data = m->hfield_data + m->hfield_adr[h];
+  s->height.resize(static_cast<size_t>(s->nrow) * s->ncol);
+  for (size_t i = 0; i < s->height.size(); ++i) {
+    s->height[i] = data[i] * m->hfield_size[4 * h + 2];
+  }
+  return true;
+}
 
 bool ResolveWater(const mjModel* m, const std::string& source, Water* w, std::string* error) {
   if (!w->current_profile.empty()) {
