@@ -51,17 +51,7 @@ enum Slot : int {
   kStalledTime,                     // [s] d->time of the call that first reported one
   kCoupleA,                         // end A on a body that moves: see CoupleSlot
   kCoupleB = kCoupleA + 5,
-  // The consistent coupling of implicit tethers (docs/coupling.md), per end on a body that
-  // moves, internal order: the end stiffness S [N/m] (3x3, column-major) of the tether's last
-  // step and whether it is set; the force last applied to the site [N] (3) and whether it is
-  // set (for the body's other acceleration, read back from the next call's qacc).
-  kEndStiffA = kCoupleB + 5,  // S (9), the end segment's outward tangent (3)
-  kEndStiffB = kEndStiffA + 12,
-  kEndStiffSet = kEndStiffB + 12,    // (2)
-  kAppliedA = kEndStiffSet + 2,      // (3)
-  kAppliedB = kAppliedA + 3,         // (3)
-  kAppliedSet = kAppliedB + 3,       // (2)
-  kHeader = kAppliedSet + 2,  // x (3 x n) then v (3 x n) follow, then the integrator's history
+  kHeader = kCoupleB + 5,  // x (3 x n) then v (3 x n) follow, then the integrator's history
                            // (Tether::HistorySize, bdf2), then with contact `capacity` records
 };
 // A contact reaction record: body, force on it [N] (3), point of application [m] (3), applied
@@ -98,9 +88,6 @@ struct AttachedTether {
   // End on a body with degrees of freedom (not the world, not mocap): the body feels the end
   // force explicitly over its step (docs/coupling.md).
   bool coupled[2] = {false, false};
-  // Coupled end of an implicit tether (implicit, implicit2, bdf2) under MuJoCo's Euler or
-  // implicit integrator: the site receives the backward-Euler end force (ConsistentForce).
-  bool consistent[2] = {false, false};
   CouplingLimit limit[2];  // the time-step advisor's figures at load time
   // A winch (winch:NAME, docs/winch.md) at internal end A (sites swapped when declared at B).
   bool winch = false;
@@ -266,59 +253,6 @@ Mat3 SiteInverseMass(const mjModel* m, mjData* d, int s, double* jac) {
   return 0.5 * (W + W.transpose());
 }
 
-// The end stiffness of a tether step (or of the state, at a restart) into u.
-void StoreEndStiffness(const StepStatus& status, double* u) {
-  for (int end = 0; end < 2; ++end) {
-    if (!status.end_stiffness_set[end]) continue;
-    double* dst = u + (end == 0 ? kEndStiffA : kEndStiffB);
-    std::copy(status.end_stiffness[end].data(), status.end_stiffness[end].data() + 9, dst);
-    for (int k = 0; k < 3; ++k) dst[9 + k] = status.end_tangent[end][k];
-    u[kEndStiffSet + end] = 1;
-  }
-}
-
-// The force a coupled end of an implicit tether gives its body over the body's next step
-// (docs/coupling.md). Not the force F of the tether's state now, held over the step, but F
-// plus the end's response to the change of the site's velocity over the step,
-//   F+ = F + h S (v+ - v),   v+ - v = h (a_other + W F+),
-// S the end stiffness of the tether's last step (Tether::EndStiffnessOfStep: the end segment
-// with the interior's implicit response, -(1/h^2) the Schur complement of its Newton matrix), W
-// = J M^-1 J^T the body's inverse mass at the site, a_other the site's acceleration from
-// everything but this force (MuJoCo's Euler step: v+ = v + h qacc):
-//   (I - h^2 S W) F+ = F + h^2 S a_other.
-// The part of the end's response to the site moving on at its present velocity is not
-// predicted: the interior moves along with it (a towed tether), and predicting it from S
-// alone, which knows nothing of the interior's own velocities, was 35 times too large on the
-// BlueROV2 (docs/coupling.md). On the model problem (a body of mass m on a spring k) this is
-// symplectic Euler with the spring softened to k/(1 + (omega h)^2): omega' h < 1, stable at any
-// omega h. a_other is taken from the last step's qacc, which MuJoCo leaves in mjData until this
-// step's is computed: a_other = J qacc - W F+_last (the other forces lagged one step); with it a
-// body held at rest by thrust against the tether receives exactly F.
-Vec3 ConsistentForce(const mjModel* m, mjData* d, const AttachedTether& at, int end,
-                     const Vec3& F, const Vec3& v, const Vec3& v_nb, double* u, double* jac) {
-  if (u[kEndStiffSet + end] == 0) return F;
-  const double* stored = u + (end == 0 ? kEndStiffA : kEndStiffB);
-  const Mat3 S = Eigen::Map<const Mat3>(stored);
-  const Vec3 tangent(stored + 9);
-  const Mat3 W = SiteInverseMass(m, d, at.site[end], jac);  // J left in jac[0, 3 nv)
-  double* applied = u + (end == 0 ? kAppliedA : kAppliedB);
-  Vec3 a_other = Vec3::Zero();
-  if (u[kAppliedSet + end] != 0) {
-    for (int k = 0; k < 3; ++k) a_other[k] = mju_dot(jac + k * m->nv, d->qacc, m->nv);
-    a_other -= W * Vec3(applied);
-  }
-  const double h = m->opt.timestep;
-  const Mat3 A = Mat3::Identity() - h * h * S * W;
-  Vec3 Fp = A.partialPivLu().solve(F + h * S * (v - v_nb + h * a_other));
-  if (!Fp.allFinite()) return F;
-  // A tension-only tether cannot push: a result that pushes along the end segment means it
-  // goes slack within the step, where it gives nothing.
-  if (!(at.tether.params().effects & kCompression) && Fp.dot(tangent) < 0) Fp.setZero();
-  for (int k = 0; k < 3; ++k) applied[k] = Fp[k];
-  u[kAppliedSet + end] = 1;
-  return Fp;
-}
-
 // One tether at one callback: initialise or advance to d->time, then apply the reactions.
 void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* work, double* jac) {
   double* u = d->userdata + at.offset;
@@ -363,27 +297,6 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
       }
     } else {
       tether.InitialShape(now, x, v);
-      // The consistent coupling's first step: the end stiffness of the initial state.
-      Ends ends = now;
-      for (int end = 0; end < 2; ++end) {
-        if (at.consistent[end]) ends.stiffness |= 1u << end;
-      }
-      if (ends.stiffness) {
-        // One trial step of the tether from its initial state, on a copy, with the ends
-        // moving on at their velocities: the end stiffness with the interior's response
-        // (without it, the end segment alone, the first step's force was far too stiff).
-        const double h = m->opt.timestep;
-        double* xs = mj_stackAlloc(d, tether.StateSize());
-        std::copy(x, x + tether.StateSize(), xs);
-        Ends to = ends;
-        to.time = ends.time + h;
-        to.a.pos += h * ends.a.vel;
-        if (!free_end) to.b.pos += h * ends.b.vel;
-        const StepStatus st =
-            tether.Advance(xs, xs + 3 * tether.nodes(), ends, to, h, work, static_cast<double*>(nullptr));
-        std::fill(u + kEndStiffA, u + kHeader, 0.0);
-        if (st.ok) StoreEndStiffness(st, u);
-      }
     }
     // bdf2 starts again with a backward-Euler step (no history yet).
     if (history) history[0] = 0;
@@ -412,9 +325,6 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
       from.time = u[kTime];
       now.time = d->time;
       from.contacts = now.contacts = &set;
-    }
-    for (int end = 0; end < 2; ++end) {
-      if (at.consistent[end]) now.stiffness |= 1u << end;
     }
     StepStatus status;
     if (at.winch) {
@@ -474,7 +384,6 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
     }
     given[0] = status.work_a;
     given[1] = status.work_b;
-    StoreEndStiffness(status, u);
     u[kPrevTime] = u[kTime];
     std::copy(u + kEndA, u + kEndA + 3, u + kPrevPosA);
     std::copy(u + kEndB, u + kEndB + 3, u + kPrevPosB);
@@ -546,7 +455,6 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
   if (restarted) {
     std::fill(u + kCoupleA, u + kCoupleA + kCoupleSize, 0.0);
     std::fill(u + kCoupleB, u + kCoupleB + kCoupleSize, 0.0);
-    std::fill(u + kAppliedA, u + kHeader, 0.0);
   }
   double* cache = u + kForceA;
   // Stored as declared: a winch at end B runs internally as end A.
@@ -569,20 +477,6 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
   }
   u[kTensionA] = stored.tension_a;
   u[kTensionB] = stored.tension_b;
-  // The stored reactions are the tether's own; the sites of implicit tethers' coupled ends
-  // receive the backward-Euler force instead (ConsistentForce).
-  if (at.consistent[0] || at.consistent[1]) {
-    const int first = at.winch ? LoadPayout(at, u).first : 0;
-    const int n = tether.nodes();
-    if (at.consistent[0]) {
-      r.force_a = ConsistentForce(m, d, at, 0, r.force_a, now.a.vel,
-                                  Vec3(v + 3 * std::min(first + 1, n - 1)), u, jac);
-    }
-    if (at.consistent[1]) {
-      r.force_b = ConsistentForce(m, d, at, 1, r.force_b, now.b.vel,
-                                  Vec3(v + 3 * std::max(n - 2, 0)), u, jac);
-    }
-  }
   if (at.body[0] > 0 && !at.mocap[0]) {
     mj_applyFT(m, d, r.force_a.data(), r.torque_a.data(), d->site_xpos + 3 * at.site[0],
                at.body[0], d->qfrc_passive);
@@ -1194,10 +1088,6 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
       // without joints have none).
       at.coupled[end] = at.body[end] > 0 && !at.mocap[end] &&
                         m->body_dofnum[at.body[end]] + DofsAbove(m, at.body[end]) > 0;
-      at.consistent[end] = at.coupled[end] &&
-                           (tether->params().integrator == Integrator::kImplicit ||
-                            tether->params().integrator == Integrator::kBdf2) &&
-                           m->opt.integrator != mjINT_RK4;
       // A free body at a tether end in water gets buoyancy, drag and current only from a
       // vehicle: declaration; without one it is dry apart from the tether.
       const int carrier = FreeCarrier(m, at.body[end]);

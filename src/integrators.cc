@@ -30,7 +30,7 @@ EndState Interpolate(const EndState& e0, const EndState& e1, double dt, double s
 Ends Interpolate(const Ends& from, const Ends& to, double dt, double s) {
   return {Interpolate(from.a, to.a, dt, s), Interpolate(from.b, to.b, dt, s),
           from.time + s * (to.time - from.time), to.contacts,
-          from.rest + s * (to.rest - from.rest), to.stiffness};
+          from.rest + s * (to.rest - from.rest)};
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -172,7 +172,6 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   };
   place();
   if (nu == 0) {
-    if (next.stiffness) EndStiffnessOfStep(next, h, false, work, stats);
     x = xk;
     v = vk;
     return true;
@@ -464,7 +463,6 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   for (int i = 1; i <= nu; ++i) vk.col(i) += rhs.col(i - 1);
   place();
   if (linearisation_held()) {
-    if (next.stiffness) EndStiffnessOfStep(next, h, true, work, stats);
     x = xk;
     v = vk;
     return true;
@@ -506,106 +504,9 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
     }
     phi = trial;
   }
-  if (next.stiffness) EndStiffnessOfStep(next, h, true, work, stats);
   x = xk;
   v = vk;
   return true;
-}
-
-// The end stiffness of the implicit step just taken (ImplicitStep, step h, iterate in the
-// workspace's x2, v2, its matrix A = M - h D - h^2 K factored in the band when `factored`), for
-// the consistent vehicle coupling (docs/coupling.md). Displacing an attached end e by delta
-// over the step (its velocity by delta/h) changes the force on the end's site by
-//   dF = (K_ee + D_ee/h) delta + (h K_ie + D_ie)^T dv,   A dv = (h K_ie + D_ie) delta
-// (the interior's backward-Euler response: G_i = M (v_i+ - v_i) - h f_i = 0 linearised), so
-//   S = dF/d(delta) = -(1/h^2) (B_ee - C^T A^-1 C),
-// with B_ee = -(h D_ee + h^2 K_ee) the end's own block of the matrix (without mass) and
-// C = A_ie the blocks that would couple the end to its dynamic neighbours (one node; two with
-// bending): the Schur complement of the matrix extended by the end node, B_ee - C^T A^-1 C,
-// is the end's effective (dynamic) stiffness times -h^2. The blocks are those the assembly in
-// ImplicitStep would give node e (taut or compressed axial stiffness and damping of the end
-// segment, bending stencils through e), at the final iterate. Three solves with the existing
-// factorisation (right-hand sides nonzero only near the end), O(N) per end.
-void Tether::EndStiffnessOfStep(const Ends& next, double h, bool factored, double* work,
-                                StepStatus* stats) const {
-  Work w(work, N_);
-  const int n = N_ + 1;
-  const int nu = N_ - 1 + (p_.free_end ? 1 : 0);
-  ConstNodes xk(w.x2, 3, n), vk(w.v2, 3, n);
-  const double h2 = h * h;
-  for (int end = 0; end < 2; ++end) {
-    if (!(next.stiffness & (1u << end)) || (end == 1 && p_.free_end)) continue;
-    const int j = end == 0 ? 0 : N_ - 1;            // its segment
-    const int nb[2] = {end == 0 ? 1 : N_ - 1, end == 0 ? 2 : N_ - 2};  // its neighbours
-    Mat3 Bee = Mat3::Zero();
-    Mat3 C[2] = {Mat3::Zero(), Mat3::Zero()};       // A(nb[k], e)
-    if (Has(kAxial)) {
-      const double L0 = j == 0 && head_ ? WinchRest(next) : L0_;
-      const Vec3 d = xk.col(j + 1) - xk.col(j);
-      const double l = d.norm();
-      if (l > kMinLengthRatio * L0) {
-        const Vec3 tj = d / l;  // from node j to node j + 1
-        const double ca = Has(kDamping) ? p_.damping / L0 : 0;
-        const double rate = tj.dot(vk.col(j + 1) - vk.col(j)) / L0;  // [1/s]
-        Mat3 B = Mat3::Zero();
-        stats->end_tangent[end] = end == 0 ? tj : Vec3(-tj);  // outward, from the site
-        if (l > L0) {
-          const double T = std::max(0.0, p_.EA * (l / L0 - 1) + ca * L0 * rate);
-          const double geo = h2 * T / l;
-          B = (h2 * p_.EA / L0 + (T > 0 ? h * ca : 0) - geo) * tj * tj.transpose() +
-              geo * Mat3::Identity();
-        } else if (Has(kCompression)) {
-          const bool pushes = p_.EAc * (l / L0 - 1) + ca * L0 * rate < 0;
-          B = (h2 * p_.EAc / L0 + (pushes ? h * ca : 0)) * tj * tj.transpose();
-        }
-        Bee += B;
-        C[0] -= B;
-      }
-    }
-    if (Has(kBending)) {
-      // Curvature at the neighbour (stencil 1, -2, 1 over e, nb[0], nb[1]) and the clamp
-      // (-1, 1 over e, nb[0]), as ImplicitStep's stencils: k = h^2 EI/(weight L0^2).
-      if (N_ >= 2) {
-        const double k = h2 * p_.EI / (CurvatureWeight(nb[0]) * L0_ * L0_);
-        Bee.diagonal().array() += k;
-        C[0].diagonal().array() -= 2 * k;
-        C[1].diagonal().array() += k;
-      }
-      if (Has(kClamp) && (end == 0 ? p_.clamp_a : p_.clamp_b)) {
-        const double k = h2 * p_.EI / (0.5 * rest_length(j) * L0_ * L0_);
-        Bee.diagonal().array() += k;
-        C[0].diagonal().array() -= k;
-      }
-    }
-    Mat3 Sigma = Bee;
-    if (factored && nu > 0) {
-      const BlockBand A(w.band, nu, Has(kBending) ? 2 : 1);
-      Nodes r(w.dv, 3, nu);
-      for (int c = 0; c < 3; ++c) {
-        r.setZero();
-        for (int k = 0; k < 2; ++k) {
-          if (Dynamic(nb[k]) && nb[k] - 1 < nu) r.col(nb[k] - 1) = C[k].col(c);
-        }
-        A.Solve(w.dv);
-        for (int k = 0; k < 2; ++k) {
-          if (Dynamic(nb[k]) && nb[k] - 1 < nu) Sigma.col(c) -= C[k].transpose() * r.col(nb[k] - 1);
-        }
-      }
-    }
-    stats->end_stiffness[end] = -Sigma / h2;
-    stats->end_stiffness_set[end] = true;
-  }
-}
-
-void Tether::EndStiffnessNow(const double* x, const double* v, const Ends& ends, double h,
-                             double* work, StepStatus* stats) const {
-  Work w(work, N_);
-  const int n = N_ + 1;
-  Nodes xk(w.x2, 3, n), vk(w.v2, 3, n);
-  xk = ConstNodes(x, 3, n);
-  vk = ConstNodes(v, 3, n);
-  PlaceEnds(ends, xk, vk);
-  EndStiffnessOfStep(ends, h, false, work, stats);
 }
 
 // An implicit step whose Newton iteration did not settle is redone as two half steps (the

@@ -49,10 +49,6 @@ struct Ends {
   // With a winch (a view from Tether::Deployed): the rest length of the winch segment (segment
   // 0, from the drum at end A) at this instant [m]; 0 without a winch.
   double rest = 0;
-  // Which attached ends want their end stiffness (StepStatus::end_stiffness) from the implicit
-  // schemes' last step: bit 0 end A, bit 1 end B (the plugin's consistent coupling,
-  // docs/coupling.md).
-  unsigned stiffness = 0;
 };
 
 // The deployment of a tether with a winch at end A (docs/winch.md). Nodes 0..first-1 are on
@@ -89,15 +85,6 @@ struct StepStatus {
   // sum over tether steps of the end node's force (at the step's evaluation) times the end's
   // displacement. What the tether gave the bodies, for the coupling's work balance.
   double work_a = 0, work_b = 0;
-  // The implicit schemes (implicit, implicit2, bdf2), for each end requested in
-  // Ends::stiffness: dF/d(delta) [N/m] (3x3), how the force on the end's site changes over one
-  // tether step per displacement delta of the site, the interior nodes responding implicitly
-  // (the Schur complement of the last step's Newton matrix; see EndStiffnessOfStep). Valid
-  // where end_stiffness_set.
-  Mat3 end_stiffness[2] = {Mat3::Zero(), Mat3::Zero()};
-  bool end_stiffness_set[2] = {false, false};
-  // With them: the end segment's outward unit tangent (from the site toward its neighbour).
-  Vec3 end_tangent[2] = {Vec3::Zero(), Vec3::Zero()};
 };
 
 class Tether {
@@ -167,12 +154,6 @@ class Tether {
   // deployed mass mu L and the momentum (docs/winch.md); ends `e` (the drum at end A).
   // Returns +1 (inserted), -1 (removed) or 0.
   int Regrid(double* x, double* v, const Ends& e, Payout* payout) const;
-
-  // The end stiffness (StepStatus::end_stiffness) of the state as it is, for the ends in
-  // ends.stiffness, without the interior's response (its end segment and bending stencils
-  // only): for the body's first step, before any tether step.
-  void EndStiffnessNow(const double* x, const double* v, const Ends& ends, double h,
-                       double* work, StepStatus* stats) const;
 
   // Forces on every node f (3 x n) [N], and segment tensions T (N) [N], >= 0 (a compression
   // reads 0), when T is not null, from the state as it is (ends as stored in x, v).
@@ -271,8 +252,6 @@ class Tether {
                double* work) const;
   bool ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
                     double* work, StepStatus* stats) const;
-  void EndStiffnessOfStep(const Ends& next, double h, bool factored, double* work,
-                          StepStatus* stats) const;
   void ImplicitStepAdaptive(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
                             int depth, double* work, StepStatus* stats,
                             double impulse_weight = 1) const;

@@ -1,4 +1,4 @@
-# The consistent vehicle-tether coupling of the implicit integrators (issue 11 item 1;
+# A light vehicle on a stiff tether at the vehicle step (issue 11 item 1;
 # docs/coupling.md).
 add_executable(coupling_consistent_test coupling_consistent_test.cc)
 target_link_libraries(coupling_consistent_test PRIVATE mjtether_plugin GTest::gtest_main)
