@@ -7,6 +7,7 @@
 
 Classes, first that applies (the labels of tests/scene_fuzz_known.txt):
   coupling          omega h >= 1 at the vehicle, omega = sqrt(EA / (L0 (m + a_min)))
+  open-energy       the tether gains energy beyond the work of its ends (no current)
   open-one-two-segments   a tether of 1 or 2 segments
   open-thrust-qacc  MuJoCo's bad-qacc warning with a thrust scheduled
   open-transient    disagrees with the 0.2 ms run (omega h < 1)
@@ -21,13 +22,15 @@ LINE = re.compile(r"^seed (\d+)( draw=(\d+))? \[(\w+), N=(\d+), EA=([^,]+), m=([
                   r"omega\*h=([^,]+), seabed kind (\d), thrust/holds=([^\]]+)\]: (pass|FAIL): "
                   r"([^:]+): ?(.*)$")
 LIMITS = {"explicit": "2", "rk4": "0.8", "implicit2": "4", "implicit": "none", "bdf2": "none"}
-CLASSES = ["coupling", "open-one-two-segments", "open-thrust-qacc", "open-transient",
+CLASSES = ["coupling", "open-energy", "open-one-two-segments", "open-thrust-qacc", "open-transient",
            "open-other"]
 
 
 def classify(integ, n, omega_h, thrust, kind):
     if omega_h >= 1:
         return "coupling"
+    if kind.startswith("tether gains energy"):
+        return "open-energy"
     if n <= 2:
         return "open-one-two-segments"
     if kind == "MuJoCo warning" and thrust > 0:
