@@ -704,8 +704,8 @@ double ThrustOn(const mjModel* m, const mjData* d, int body) {
 
 // The most likely cause of a divergence, from the state of the scene when it was reported,
 // with what to change; empty if none of the checkable causes applies (the step is then the
-// likely one). In order: thrust beyond what the tether holds, ends pulled apart beyond
-// length (1 + max_strain), an end moving more than half of max_strain L0 in one step, an end
+// likely one). In order: thrust beyond what the tether holds, ends pulled apart to a mean
+// strain within the strain spread along the line of max_strain (or beyond it), an end moving more than half of max_strain L0 in one step, an end
 // below the seabed, a divergence within kStartSteps steps of a stretched start.
 std::string Diagnose(const mjModel* m, const mjData* d, const Environment& env,
                      const AttachedTether& at, const double* u) {
@@ -750,10 +750,40 @@ std::string Diagnose(const mjModel* m, const mjData* d, const Environment& env,
   auto moved_by_motion = [&](int end) {
     return at.mocap[end] && mj_name2id(m, mjOBJ_TEXT, ("motion:" + body_name(end)).c_str()) >= 0;
   };
-  if (both && (pos[1] - pos[0]).norm() > p.length * (1 + p.max_strain)) {
-    s << "the ends were pulled " << (pos[1] - pos[0]).norm()
-      << " m apart, more than length x (1 + max_strain) = " << p.length * (1 + p.max_strain)
-      << " m";
+  // Ends pulled apart. The strain is not uniform along a pulled line: where it first crosses
+  // max_strain, the mean strain span / length - 1 can still be below it by the strain spread
+  // along the line (issue 11: a mocap end pulled at 0.5 m/s diverged at a mean strain of
+  // 0.0998 < max_strain 0.1 and was told to reduce the step). Two contributions, summed:
+  //  - weight: along a static line under its net weight w per length the tension changes by
+  //    w dz between two points dz apart along gravity (the catenary's T = T0 + w (z - z0),
+  //    Irvine 1981, ch. 1), so the strain spread between the ends is w |dz| / EA;
+  //  - pulling speed: an end separating at v starts a strain step v / c, c = sqrt(EA / mu) the
+  //    axial wave speed, which doubles where it reflects at the other end: 2 v / c.
+  // Drag along the line (a current) is not included. The pull is the cause when the mean
+  // strain is positive (the ends farther apart than the length) and within that spread of
+  // max_strain; beyond length x (1 + max_strain) it always is.
+  double mean_strain = -1, spread = 0, weight_spread = 0, wave_spread = 0, separating = 0;
+  if (both) {
+    const Vec3 chord = pos[1] - pos[0];
+    mean_strain = chord.norm() / p.length - 1;
+    const Vec3 g = t.env().gravity.norm() > 0 ? Vec3(t.env().gravity.normalized()) : Vec3::Zero();
+    const double w = 2 * t.node_weight(0).norm() / t.rest_segment_length();  // [N/m] net weight
+    weight_spread = w * std::abs(chord.dot(g)) / p.EA;
+    separating = chord.norm() > 0 ? std::max(0.0, (vel[1] - vel[0]).dot(chord.normalized())) : 0;
+    wave_spread = 2 * separating / std::sqrt(p.EA / p.mass_per_length);
+    spread = weight_spread + wave_spread;
+  }
+  if (both && mean_strain > 0 && mean_strain >= p.max_strain - spread) {
+    s << "the ends were pulled " << (pos[1] - pos[0]).norm() << " m apart, a mean strain of "
+      << mean_strain << " against max_strain = " << p.max_strain;
+    if (mean_strain <= p.max_strain) {
+      s << " (length x (1 + max_strain) = " << p.length * (1 + p.max_strain)
+        << " m); the strain along a pulled line exceeds its mean by up to " << spread
+        << " here (net weight w |dz| / EA = " << weight_spread << ", the ends separating at "
+        << separating << " m/s: 2 v / c = " << wave_spread << ")";
+    } else {
+      s << ", more than length x (1 + max_strain) = " << p.length * (1 + p.max_strain) << " m";
+    }
     for (int end = 0; end < 2; ++end) {
       if (moved_by_motion(end)) {
         s << ", by the prescribed motion of body '" << body_name(end)

@@ -1,0 +1,86 @@
+#!/usr/bin/env python3
+"""Classify the failing scenes of a verbose scene-fuzzer log (docs/scene_fuzzer.md).
+
+  MJTETHER_SCENE_FUZZ_VERBOSE=1 build/tests/scene_fuzz_test > fuzz.log
+  python3 tools/scene_fuzz_classify.py fuzz.log            # known-list lines, by class
+  python3 tools/scene_fuzz_classify.py --counts fuzz.log   # outcome and class counts
+
+Classes, first that applies (the labels of tests/scene_fuzz_known.txt):
+  coupling          omega h >= 1 at the vehicle, omega = sqrt(EA / (L0 (m + a_min)))
+  open-energy       the tether gains energy beyond the work of its ends (no current)
+  open-one-two-segments   a tether of 1 or 2 segments
+  open-thrust-qacc  MuJoCo's bad-qacc warning with a thrust scheduled
+  open-transient    disagrees with the 0.2 ms run (omega h < 1)
+  open-other        anything else (a bad qacc without thrust, a step blamed that 0.2 ms
+                    does not cure)
+"""
+import re
+import sys
+from collections import Counter, OrderedDict
+
+LINE = re.compile(r"^seed (\d+)( draw=(\d+))? \[(\w+), N=(\d+), EA=([^,]+), m=([^ ]+) kg, "
+                  r"omega\*h=([^,]+), seabed kind (\d), thrust/holds=([^\]]+)\]: (pass|FAIL): "
+                  r"([^:]+): ?(.*)$")
+LIMITS = {"explicit": "2", "rk4": "0.8", "implicit2": "4", "implicit": "none", "bdf2": "none"}
+CLASSES = ["coupling", "open-energy", "open-one-two-segments", "open-thrust-qacc", "open-transient",
+           "open-other"]
+
+
+def classify(integ, n, omega_h, thrust, kind):
+    if omega_h >= 1:
+        return "coupling"
+    if kind.startswith("tether gains energy"):
+        return "open-energy"
+    if n <= 2:
+        return "open-one-two-segments"
+    if kind == "MuJoCo warning" and thrust > 0:
+        return "open-thrust-qacc"
+    if kind.startswith("disagrees"):
+        return "open-transient"
+    return "open-other"
+
+
+def main():
+    counts_only = "--counts" in sys.argv
+    path = [a for a in sys.argv[1:] if not a.startswith("--")][0]
+    seen = OrderedDict()
+    for raw in open(path):
+        m = LINE.match(raw.strip())
+        if not m:
+            continue
+        seed, draw = int(m.group(1)), int(m.group(3) or 2)
+        if (seed, draw) in seen:
+            continue
+        seen[(seed, draw)] = m
+    outcomes, classes = Counter(), Counter()
+    lines = {c: [] for c in CLASSES}
+    for (seed, draw), m in seen.items():
+        integ, n, ea, mass = m.group(4), int(m.group(5)), float(m.group(6)), float(m.group(7))
+        omega_h, sb, thrust = float(m.group(8)), m.group(9), float(m.group(10))
+        passed, kind, detail = m.group(11) == "pass", m.group(12), m.group(13)
+        outcomes[("pass  " if passed else "FAIL  ") + kind] += 1
+        if passed:
+            continue
+        c = classify(integ, n, omega_h, thrust, kind)
+        classes[c] += 1
+        detail = re.sub(r"Nan, Inf or huge value in QACC", "bad qacc", detail)
+        detail = re.sub(r" The simulation is unstable\.", "", detail)
+        tag = f"{seed:<5}" + ("draw=1  " if draw == 1 else "")
+        lines[c].append(f"{tag}{c} omega*h={omega_h:.2g} {integ} (limit {LIMITS[integ]}), N={n}, "
+                        f"EA={ea:.3g}, {mass:.3g} kg, seabed kind {sb}, thrust {thrust:.2f} EA: "
+                        f"{kind}: {detail}"[:230])
+    if counts_only:
+        print(f"{len(seen)} scenes")
+        for k, v in sorted(outcomes.items()):
+            print(f"  {v:5d}  {k}")
+        print("failures by class:")
+        for c in CLASSES:
+            print(f"  {classes[c]:5d}  {c}")
+        return
+    for c in CLASSES:
+        for l in lines[c]:
+            print(l)
+
+
+if __name__ == "__main__":
+    main()
