@@ -36,6 +36,11 @@ class BlockBand {
   static int Size(int n) { return 27 * n; }
 
   void SetZero() { std::fill(a_, a_ + Size(n_), 0.0); }
+  // Zeroes the coupling blocks L1 (and L2 with two bands) only, for a caller that assigns
+  // every diagonal block.
+  void SetZeroCoupling() {
+    for (int i = 0; i < n_; ++i) std::fill(a_ + 27 * i + 9, a_ + 27 * i + 9 * (1 + bands_), 0.0);
+  }
   Block D(int i) { return Block(a_ + 27 * i); }
   Block L1(int i) { return Block(a_ + 27 * i + 9); }
   Block L2(int i) { return Block(a_ + 27 * i + 18); }
@@ -44,6 +49,7 @@ class BlockBand {
   // is not positive definite (leading minors of S(i) not all positive), or -1 on success.
   int Factor() {
     double b1[9], b2[9], l[9];
+    double adj[9], r = 0;  // the last row's adjugate adj(S) and 1/det(S)
     for (int i = 0; i < n_; ++i) {
       double* d = a_ + 27 * i;
       double* l1 = d + 9;
@@ -57,8 +63,12 @@ class BlockBand {
         SubMulTransposed(l1, b2, a_ + 27 * (i - 1) + 9);  // B1 = A(i,i-1) - B2 L(i-1,i-2)^T
       }
       if (i >= 1) {
+        // L(i,i-1) = B1 S(i-1)^-1 = (B1 adj(S(i-1))) r(i-1), S -= L(i,i-1) B1^T: the product
+        // with the adjugate (kept from the last row) does not wait for the last row's
+        // division, which would otherwise sit on the row-to-row chain.
         std::copy(l1, l1 + 9, b1);
-        Mul(b1, a_ + 27 * (i - 1), l);                // L(i,i-1) = B1 S(i-1)^-1
+        Mul(b1, adj, l);                              // B1 adj(S(i-1))
+        for (double& e : l) e *= r;                   // L(i,i-1)
         SubMulTransposed(S, l, b1);                   // S -= L(i,i-1) B1^T
         std::copy(l, l + 9, l1);
       }
@@ -72,10 +82,11 @@ class BlockBand {
       const double det = S[0] * c00 + S[1] * c10 + S[2] * c20;
       // Sylvester: S is positive definite iff its leading minors S00, c22, det are positive.
       if (!(S[0] > 0) || !(c22 > 0) || !(det > 0)) return i;
-      const double r = 1 / det;
-      d[0] = c00 * r, d[1] = c10 * r, d[2] = c20 * r;
-      d[3] = d[1], d[4] = c11 * r, d[5] = c21 * r;
-      d[6] = d[2], d[7] = d[5], d[8] = c22 * r;
+      adj[0] = c00, adj[1] = c10, adj[2] = c20;
+      adj[3] = c10, adj[4] = c11, adj[5] = c21;
+      adj[6] = c20, adj[7] = c21, adj[8] = c22;
+      r = 1 / det;
+      for (int k = 0; k < 9; ++k) d[k] = adj[k] * r;
     }
     return -1;
   }
