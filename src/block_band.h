@@ -49,7 +49,6 @@ class BlockBand {
   // is not positive definite (leading minors of S(i) not all positive), or -1 on success.
   int Factor() {
     double b1[9], b2[9], l[9];
-    double adj[9], r = 0;  // the last row's adjugate adj(S) and 1/det(S)
     for (int i = 0; i < n_; ++i) {
       double* d = a_ + 27 * i;
       double* l1 = d + 9;
@@ -63,12 +62,8 @@ class BlockBand {
         SubMulTransposed(l1, b2, a_ + 27 * (i - 1) + 9);  // B1 = A(i,i-1) - B2 L(i-1,i-2)^T
       }
       if (i >= 1) {
-        // L(i,i-1) = B1 S(i-1)^-1 = (B1 adj(S(i-1))) r(i-1), S -= L(i,i-1) B1^T: the product
-        // with the adjugate (kept from the last row) does not wait for the last row's
-        // division, which would otherwise sit on the row-to-row chain.
         std::copy(l1, l1 + 9, b1);
-        Mul(b1, adj, l);                              // B1 adj(S(i-1))
-        for (double& e : l) e *= r;                   // L(i,i-1)
+        Mul(b1, a_ + 27 * (i - 1), l);                // L(i,i-1) = B1 S(i-1)^-1
         SubMulTransposed(S, l, b1);                   // S -= L(i,i-1) B1^T
         std::copy(l, l + 9, l1);
       }
@@ -82,11 +77,10 @@ class BlockBand {
       const double det = S[0] * c00 + S[1] * c10 + S[2] * c20;
       // Sylvester: S is positive definite iff its leading minors S00, c22, det are positive.
       if (!(S[0] > 0) || !(c22 > 0) || !(det > 0)) return i;
-      adj[0] = c00, adj[1] = c10, adj[2] = c20;
-      adj[3] = c10, adj[4] = c11, adj[5] = c21;
-      adj[6] = c20, adj[7] = c21, adj[8] = c22;
-      r = 1 / det;
-      for (int k = 0; k < 9; ++k) d[k] = adj[k] * r;
+      const double r = 1 / det;
+      d[0] = c00 * r, d[1] = c10 * r, d[2] = c20 * r;
+      d[3] = d[1], d[4] = c11 * r, d[5] = c21 * r;
+      d[6] = d[2], d[7] = d[5], d[8] = c22 * r;
     }
     return -1;
   }
