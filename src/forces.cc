@@ -376,14 +376,7 @@ void Tether::Forces(const double* xp, const double* vp, const Ends& ends, double
   Nodes f(fp, 3, n), t(w.t, 3, N_), M(w.M, 3, n), q(w.q, 3, n);
   ConstNodes tc(w.t, 3, N_), Mc(w.M, 3, n), qc(w.q, 3, n);
   double* T = Tp ? Tp : w.T;
-  // The net weight starts the sum where it is uniform (no winch view): f = W instead of f = 0
-  // and f += W, one pass fewer.
-  const bool weight = Has(kWeight) || Has(kBuoyancy);
-  if (weight && !head_) {
-    f = WeightMatrix();
-  } else {
-    f.setZero();
-  }
+  f.setZero();
   SegmentGeometry(x, t, w.l);
   if (Has(kAxial)) {
     // Writes every T[j].
@@ -395,8 +388,12 @@ void Tether::Forces(const double* xp, const double* vp, const Ends& ends, double
     BendingMoments(tc, ends, M);
     AddBending(tc, w.l, Mc, f);
   }
-  if (weight && head_) {
-    for (int i = 0; i <= N_; ++i) f.col(i) += Weight(i);
+  if (Has(kWeight) || Has(kBuoyancy)) {
+    if (head_) {
+      for (int i = 0; i <= N_; ++i) f.col(i) += Weight(i);
+    } else {
+      f += WeightMatrix();
+    }
   }
   if (Has(kDrag) || Has(kAddedMass) || Has(kSeabed)) NodeTangents(x, tc, q);
   if (Has(kDrag)) AddDrag(x, v, qc, w.l, f);
