@@ -36,6 +36,11 @@ class BlockBand {
   static int Size(int n) { return 27 * n; }
 
   void SetZero() { std::fill(a_, a_ + Size(n_), 0.0); }
+  // Zeroes the coupling blocks L1 (and L2 with two bands) only, for a caller that assigns
+  // every diagonal block.
+  void SetZeroCoupling() {
+    for (int i = 0; i < n_; ++i) std::fill(a_ + 27 * i + 9, a_ + 27 * i + 9 * (1 + bands_), 0.0);
+  }
   Block D(int i) { return Block(a_ + 27 * i); }
   Block L1(int i) { return Block(a_ + 27 * i + 9); }
   Block L2(int i) { return Block(a_ + 27 * i + 18); }

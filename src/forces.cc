@@ -68,33 +68,33 @@ void Tether::AddAxial(ConstNodes x, ConstNodes v, ConstNodes t, const double* l,
   const double inv_L0 = 1 / L0_;  // [1/m]
   const double L0sq = L0_ * L0_;
   const bool engaging = start && Has(kDamping);
-  for (int j = 0; j < N_; ++j) {
+  if (head_) {
+    // The winch segment, rest length r = rest0 growing at the payout speed s: strain
+    // l/r - 1, strain rate d(l/r)/dt = t.(dv - (l/r) s t)/r: the velocity difference
+    // relative to the material leaving the drum, (l/r) s along t (docs/winch.md). The rate
+    // goes to AxialForce as L0 deps/dt.
+    double engage_h = 0;
+    const double r = rest0, lr = l[0] / r;
+    Vec3 dv = (L0_ / r) * (Vec3(v.col(1) - v.col(0)) - (lr * speed_) * t.col(0));
+    if (engaging) {
+      const double rs = std::max(r - speed_ * start->h, 1e-9 * L0_);  // rest at the start
+      const double es = (start->x.col(1) - start->x.col(0)).norm() / rs - 1;
+      const double e = lr - 1;
+      if (e > 0 ? es <= 0 : e < 0 && es >= 0) engage_h = start->h;
+      if (start->discrete) {
+        const double from = e > 0 ? std::max(es, 0.0) : std::min(es, 0.0);
+        dv = t.col(0) * (L0_ * (e - from) / start->h);
+        engage_h = 0;
+      }
+    }
+    const double Tj = AxialForce(lr - 1, t.col(0), dv, engage_h);
+    T[0] = std::max(Tj, 0.0);
+    f.col(0) += Tj * t.col(0);
+    f.col(1) -= Tj * t.col(0);
+  }
+  for (int j = head_ ? 1 : 0; j < N_; ++j) {
     double engage_h = 0;
     Vec3 dv = v.col(j + 1) - v.col(j);
-    if (j == 0 && head_) {
-      // The winch segment, rest length r = rest0 growing at the payout speed s: strain
-      // l/r - 1, strain rate d(l/r)/dt = t.(dv - (l/r) s t)/r: the velocity difference
-      // relative to the material leaving the drum, (l/r) s along t (docs/winch.md). The rate
-      // goes to AxialForce as L0 deps/dt.
-      const double r = rest0, lr = l[0] / r;
-      dv = (L0_ / r) * (dv - (lr * speed_) * t.col(0));
-      if (engaging) {
-        const double rs = std::max(r - speed_ * start->h, 1e-9 * L0_);  // rest at the start
-        const double es = (start->x.col(1) - start->x.col(0)).norm() / rs - 1;
-        const double e = lr - 1;
-        if (e > 0 ? es <= 0 : e < 0 && es >= 0) engage_h = start->h;
-        if (start->discrete) {
-          const double from = e > 0 ? std::max(es, 0.0) : std::min(es, 0.0);
-          dv = t.col(0) * (L0_ * (e - from) / start->h);
-          engage_h = 0;
-        }
-      }
-      const double Tj = AxialForce(lr - 1, t.col(0), dv, engage_h);
-      T[0] = std::max(Tj, 0.0);
-      f.col(0) += Tj * t.col(0);
-      f.col(1) -= Tj * t.col(0);
-      continue;
-    }
     if (engaging) {
       // On the other side of L0 at the start of the step than now?
       const double ls2 = (start->x.col(j + 1) - start->x.col(j)).squaredNorm();
@@ -378,9 +378,11 @@ void Tether::Forces(const double* xp, const double* vp, const Ends& ends, double
   double* T = Tp ? Tp : w.T;
   f.setZero();
   SegmentGeometry(x, t, w.l);
-  std::fill(T, T + N_, 0.0);
   if (Has(kAxial)) {
+    // Writes every T[j].
     AddAxial(x, v, tc, w.l, T, f, start, head_ ? (ends.rest > 0 ? ends.rest : rest_) : L0_);
+  } else {
+    std::fill(T, T + N_, 0.0);
   }
   if (Has(kBending)) {
     BendingMoments(tc, ends, M);

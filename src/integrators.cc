@@ -210,14 +210,15 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   // correction replaces the residual in rhs. False if the factorisation failed.
   bool newton = false;  // past the first iteration
   auto solve = [&]() {
-    A.SetZero();
+    // The mass blocks are assigned, the coupling blocks zeroed: no pass over the whole band.
+    A.SetZeroCoupling();
     for (int i = 1; i <= nu; ++i) {
       BlockBand::Block d = A.D(i - 1);
       if (added) {
         const Vec3 qi = q.col(i);
         d = Mass(i) * I + Added(i) * (I - qi * qi.transpose());
       } else {
-        d.diagonal().setConstant(Mass(i));
+        d = Mass(i) * I;
       }
     }
     // Axial stiffness and damping of taut segments: B = h D + h^2 K with
@@ -700,21 +701,30 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
 }
 
 // Divergence: a non-finite value, a strain no tether survives, or a kinetic energy no tether
-// holds.
+// holds. Each check is one pass without square roots or divisions (x - x is 0 for every finite
+// x and NaN otherwise; the strain is compared squared); the node and the value reported are
+// looked up only when a check fails.
 void Tether::Check(ConstNodes x, ConstNodes v, const Ends& from, const Ends& to,
                    StepStatus* out) const {
   const int n = N_ + 1;
   StepStatus& status = *out;
-  for (int i = 0; i < n; ++i) {
-    if (!x.col(i).allFinite() || !v.col(i).allFinite()) {
-      status.ok = false;
-      status.node = i;
-      status.reason = "non-finite position or velocity";
-      return;
+  if (!((x - x).sum() == 0 && (v - v).sum() == 0)) {
+    for (int i = 0; i < n; ++i) {
+      if (!x.col(i).allFinite() || !v.col(i).allFinite()) {
+        status.ok = false;
+        status.node = i;
+        status.reason = "non-finite position or velocity";
+        return;
+      }
     }
   }
+  // |dx| > (1 + max_strain) L0, squared (rest_length differs only for a winch view's first).
+  const double stretch = 1 + p_.max_strain;
+  const double limit2 = stretch * stretch * L0_ * L0_;  // [m^2]
   for (int j = 0; j < N_; ++j) {
-    const double strain = (x.col(j + 1) - x.col(j)).norm() / rest_length(j) - 1;
+    const double l2 = (x.col(j + 1) - x.col(j)).squaredNorm();
+    if (!(l2 > (j == 0 && head_ ? stretch * stretch * rest_ * rest_ : limit2))) continue;
+    const double strain = std::sqrt(l2) / rest_length(j) - 1;
     if (strain > p_.max_strain) {
       status.ok = false;
       status.node = j + 1;
@@ -725,16 +735,20 @@ void Tether::Check(ConstNodes x, ConstNodes v, const Ends& from, const Ends& to,
   }
   // Energy blow-up: more kinetic energy than the tether could hold physically (an unstable
   // mode grows geometrically and crosses this long before it overflows to NaN).
-  double kinetic = 0, node_max = -1;
-  int fastest = -1;
+  double kinetic = 0;
   for (int i = 0; i < n; ++i) {
     if (!Dynamic(i)) continue;
-    const double e = 0.5 * (Mass(i) + Added(i)) * v.col(i).squaredNorm();
-    kinetic += e;
-    if (e > node_max) node_max = e, fastest = i;
+    kinetic += 0.5 * (Mass(i) + Added(i)) * v.col(i).squaredNorm();
   }
   const double bound = kEnergyBlowUp * EnergyBound(from, to);
   if (kinetic > bound) {
+    double node_max = -1;
+    int fastest = -1;
+    for (int i = 0; i < n; ++i) {
+      if (!Dynamic(i)) continue;
+      const double e = 0.5 * (Mass(i) + Added(i)) * v.col(i).squaredNorm();
+      if (e > node_max) node_max = e, fastest = i;
+    }
     status.ok = false;
     status.node = fastest;
     status.reason = "kinetic energy " + std::to_string(kinetic) + " J exceeds " +
@@ -753,19 +767,15 @@ double Tether::EnergyBound(const Ends& from, const Ends& to) const {
   double v = std::max(from.a.vel.norm(), to.a.vel.norm());
   if (!p_.free_end) v = std::max({v, from.b.vel.norm(), to.b.vel.norm()});
   if (Has(kCurrent)) v += env_.water.MaxCurrentSpeed();
-  double M = 0;  // [kg] with added mass
+  // [kg] with added mass, [N] net weight without sign: a Deployed view sums its own nodes.
+  double M = total_mass_, W = total_weight_;
   if (head_) {
-    for (int i = 0; i <= N_; ++i) M += Mass(i) + Added(i);
-  } else {
-    const int n = N_ + 1;
-    M = Eigen::Map<const Eigen::VectorXd>(mass_, n).sum() +
-        Eigen::Map<const Eigen::VectorXd>(added_, n).sum();
+    M = W = 0;
+    for (int i = 0; i <= N_; ++i) M += Mass(i) + Added(i), W += Weight(i).norm();
   }
   double E = 0.5 * p_.EA * p_.max_strain * p_.max_strain * L + 0.5 * M * v * v;
   if (Has(kBending)) E += 0.5 * p_.EI * (4 / (L0_ * L0_)) * L;
   if (Has(kCompression)) E += 0.5 * p_.EAc * L;
-  double W = 0;  // [N] net weight, without sign
-  for (int i = 0; i <= N_; ++i) W += Weight(i).norm();
   return E + W * L;
 }
 

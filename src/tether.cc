@@ -101,6 +101,8 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
   c.inv_mass_normal_ = a.inv_mass_normal.data();
   c.share_ = a.share.data();
   c.weight_ = a.weight.data();
+  c.total_mass_ = a.mass.sum() + a.added.sum();
+  c.total_weight_ = a.weight.colwise().norm().sum();
   c.arrays_ = std::move(arrays);
   // Morison drag per unit length: 1/2 rho Cdn d |vn| vn and 1/2 rho Cdt pi d |vt| vt.
   c.kn_ = 0.5 * rho * params.Cdn * params.diameter;

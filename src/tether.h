@@ -300,6 +300,9 @@ class Tether {
   const double* inv_mass_normal_ = nullptr;
   const double* share_ = nullptr;
   const double* weight_ = nullptr;  // 3 x n
+  // Sums over the nodes for EnergyBound (the whole tether; a Deployed view sums its own):
+  double total_mass_ = 0;    // [kg] mass and added mass
+  double total_weight_ = 0;  // [N] |net weight| per node
   // A Deployed view: nodes 0 (drum exit) and 1 have the lumped values of the winch segment's
   // rest length rest_ instead of the arrays' (head_ = 2; 0 in the tether itself).
   int head_ = 0;

@@ -1,6 +1,10 @@
 // Cost of the passive callback per MuJoCo step, for 10-200 segments, each integrator:
 // a tether between a fixed site and a free body in a current (the default scene's
 // physics), stepped with mj_step. Reports time per step and per node-step.
+// BM_Line*: the fixed comparison line (tests/reference_scenes.h: 100 m, EA 1e6, damping 1000,
+// no bending, fairlead on a mocap body moving x = 80 + 2 sin(2 pi t/10)), 2 ms steps, as the
+// accuracy/cost sweep runs it through MuJoCo; `x_real_time` is simulated seconds per CPU
+// second (issue 17's target: >= 250 at 100 segments, bdf2 and implicit).
 //
 //   ./build/tests/bench/bench_callback --benchmark_repetitions=5
 //     --benchmark_report_aggregates_only=true
@@ -11,6 +15,7 @@
 #include <benchmark/benchmark.h>
 #include <mujoco/mujoco.h>
 
+#include "../reference_scenes.h"
 #include "mjtether.h"
 
 namespace {
@@ -71,6 +76,66 @@ void Step(benchmark::State& state, const char* integrator, bool tether) {
   mjtether::Detach(m);
   mj_deleteModel(m);
 }
+
+// The fixed comparison line through mj_step at 2 ms (see the header): warmed up over its first
+// period (the snap from the inextensible catenary), then 10 s (one period of the fairlead)
+// before each restore of that state.
+void Line(benchmark::State& state, const char* integrator) {
+  namespace rs = mjtether::reference_scenes;
+  const int segments = static_cast<int>(state.range(0));
+  const rs::Scene s = rs::LineScene();
+  const double h = 0.002;  // [s]
+  std::ostringstream x;
+  x.precision(17);
+  x << "<mujoco><option timestep=\"" << h << "\"/><custom>"
+    << "<text name=\"water\" data=\"" << s.water << "\"/>"
+    << "<text name=\"tether:line\" data=\"ends=anchor,fair "
+    << rs::Declaration(s, segments, integrator, 0, 0) << "\"/></custom><worldbody>"
+    << "<site name=\"anchor\" pos=\"0 0 -150\"/>"
+    << "<body name=\"fairlead\" mocap=\"true\" pos=\"80 0 -100\"><site name=\"fair\"/></body>"
+    << "</worldbody></mujoco>";
+  std::string error;
+  mjModel* m = mjtether::LoadModelFromString(x.str(), "line.xml", &error);
+  if (!m) {
+    state.SkipWithError(error.c_str());
+    return;
+  }
+  mjData* d = mj_makeData(m);
+  auto step = [&]() {
+    const mjtether::Vec3 p = s.b(d->time + h).pos;  // the fairlead at the end of this step
+    for (int i = 0; i < 3; ++i) d->mocap_pos[i] = p[i];
+    mj_step(m, d);
+  };
+  const int period = static_cast<int>(std::lround(10 / h));
+  for (int k = 0; k < period; ++k) step();
+  mjData* saved = mj_copyData(nullptr, m, d);
+  int k = 0;
+  for (auto _ : state) {
+    if (++k % period == 0) {
+      state.PauseTiming();
+      mj_copyData(d, m, saved);
+      state.ResumeTiming();
+    }
+    step();
+  }
+  if (mjtether::CheckDivergence(m, d)) state.SkipWithError("the line diverged");
+  state.counters["x_real_time"] = benchmark::Counter(static_cast<double>(state.iterations()) * h,
+                                                     benchmark::Counter::kIsRate);
+  state.counters["per_node_step"] = benchmark::Counter(
+      static_cast<double>(state.iterations()) * (segments + 1),
+      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  mj_deleteData(saved);
+  mj_deleteData(d);
+  mjtether::Detach(m);
+  mj_deleteModel(m);
+}
+
+void BM_LineBdf2(benchmark::State& s) { Line(s, "bdf2"); }
+void BM_LineImplicit(benchmark::State& s) { Line(s, "implicit"); }
+void BM_LineImplicit2(benchmark::State& s) { Line(s, "implicit2"); }
+BENCHMARK(BM_LineBdf2)->Arg(80)->Arg(100);
+BENCHMARK(BM_LineImplicit)->Arg(80)->Arg(100);
+BENCHMARK(BM_LineImplicit2)->Arg(100);
 
 void BM_StepImplicit(benchmark::State& s) { Step(s, "implicit", true); }
 void BM_StepBdf2(benchmark::State& s) { Step(s, "bdf2", true); }

@@ -13,12 +13,18 @@
 //                 within noise, which shows that an effect that is off costs nothing
 // Each iteration is Advance over one tether step (the explicit scheme at 90% of its stable
 // step, the implicit ones at 2 ms) plus the end reactions, as in the MuJoCo callback.
+// Line/<integrator>/N: the fixed comparison line (tests/reference_scenes.h; axial with
+// damping, weight, buoyancy, drag, added mass; no bending), its fairlead moving, one Advance
+// of one tether step per iteration (explicit and rk4 at 90% of their stable step, the
+// implicit ones at 2 ms) without the reactions: explicit's per_node_step is the cost of one
+// force evaluation and update per node (issue 17's target: <= 20 ns).
 #include <benchmark/benchmark.h>
 #include <mujoco/mujoco.h>
 
 #include <string>
 #include <vector>
 
+#include "../reference_scenes.h"
 #include "declaration.h"
 #include "tether.h"
 
@@ -95,6 +101,52 @@ void TetherStep(benchmark::State& state, std::string declaration, bool wet) {
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
+// The fixed comparison line, engine alone (see the header). Warmed up over its first period
+// (the snap from the inextensible catenary), restored every 10 s of simulated time.
+void LineStep(benchmark::State& state, const std::string& integrator) {
+  namespace rs = reference_scenes;
+  const int N = static_cast<int>(state.range(0));
+  const rs::Scene s = rs::LineScene();
+  std::string error;
+  std::optional<Tether> t = rs::MakeTether(s, N, integrator, 0, 0, &error);
+  if (!t) {
+    state.SkipWithError(error.c_str());
+    return;
+  }
+  const double h = IsExplicit(t->params().integrator) ? 0.9 * t->ExplicitStableStep() : 0.002;
+  std::vector<double> x(3 * t->nodes()), v(3 * t->nodes()), work(t->WorkspaceSize());
+  std::vector<double> history(t->HistorySize() + 1);
+  double time = 0;
+  t->InitialShape(rs::EndsAt(s, 0), x.data(), v.data());
+  auto step = [&]() {
+    const StepStatus st = t->Advance(x.data(), v.data(), rs::EndsAt(s, time),
+                                     rs::EndsAt(s, time + h), h, work.data(), history.data());
+    time += h;
+    return st.ok;
+  };
+  const int period = static_cast<int>(10 / h);
+  for (int k = 0; k < period; ++k) step();
+  const std::vector<double> x0 = x, v0 = v, history0 = history;
+  const double time0 = time;
+  bool ok = true;
+  int k = 0;
+  for (auto _ : state) {
+    if (++k % period == 0) {
+      state.PauseTiming();
+      x = x0;
+      v = v0;
+      history = history0;
+      time = time0;
+      state.ResumeTiming();
+    }
+    ok = step() && ok;
+  }
+  if (!ok) state.SkipWithError("the line diverged");
+  state.counters["per_node_step"] =
+      benchmark::Counter(static_cast<double>(state.iterations()) * (N + 1),
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
 // MuJoCo's own step of one free body: the floor under any callback.
 void FreeBody(benchmark::State& state) {
   const std::string xml =
@@ -141,6 +193,12 @@ int main(int argc, char** argv) {
           [decl = decl](benchmark::State& s) { TetherStep(s, decl.first, decl.second); });
       for (int N : {10, 50, 100, 400}) b->Arg(N);
     }
+  }
+  for (const char* integrator : {"explicit", "rk4", "implicit", "bdf2", "implicit2"}) {
+    benchmark::RegisterBenchmark((std::string("Line/") + integrator).c_str(),
+                                 [integrator](benchmark::State& s) { LineStep(s, integrator); })
+        ->Arg(80)
+        ->Arg(100);
   }
   benchmark::RegisterBenchmark("MuJoCoFreeBody", FreeBody);
   benchmark::Initialize(&argc, argv);
