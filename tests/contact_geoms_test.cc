@@ -12,11 +12,6 @@
 namespace mjtether::testing {
 namespace {
 
-std::string Fmt(double x) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.10g", x);
-  return buf;
-}
 
 // Euclidean projection of y onto the probability simplex (Duchi et al., ICML 2008, fig. 1).
 Eigen::Vector4d ProjectSimplex(const Eigen::Vector4d& y) {

@@ -20,21 +20,7 @@
 namespace mjtether::testing {
 namespace {
 
-std::string Fmt(double x) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.10g", x);
-  return buf;
-}
 
-// Overwrites the state of tether 0 (after the first callback set its initial shape).
-void SetNodes(const mjModel* m, const mjData* d, const Eigen::Matrix3Xd& x) {
-  double* xp = const_cast<double*>(NodePositions(m, d, 0));
-  ASSERT_NE(xp, nullptr);
-  const int n = GetTether(m, 0)->nodes();
-  ASSERT_EQ(x.cols(), n);
-  for (int i = 0; i < 3 * n; ++i) xp[i] = x.data()[i];
-  for (int i = 0; i < 3 * n; ++i) xp[3 * n + i] = 0;
-}
 
 // An <hfield> asset of nrow x ncol heights e(x, y) in [0, 1] (MuJoCo's layout: row-major, rows
 // along y from -ry, columns along x from -rx), size "rx ry top base": heights e x top above the

@@ -14,21 +14,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-std::string Fmt(double x) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.10g", x);
-  return buf;
-}
 
-// Overwrites the state of tether 0 (after the first callback set its initial shape).
-void SetNodes(const mjModel* m, const mjData* d, const Eigen::Matrix3Xd& x) {
-  double* xp = const_cast<double*>(NodePositions(m, d, 0));
-  ASSERT_NE(xp, nullptr);
-  const int n = GetTether(m, 0)->nodes();
-  ASSERT_EQ(x.cols(), n);
-  for (int i = 0; i < 3 * n; ++i) xp[i] = x.data()[i];
-  for (int i = 0; i < 3 * n; ++i) xp[3 * n + i] = 0;
-}
 
 // ---------------------------------------------------------------------------------------------
 // Capstan: a dry, weightless tether wrapped by theta over a fixed cylinder of radius R, slipping

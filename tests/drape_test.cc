@@ -13,19 +13,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-std::string Fmt(double x) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.10g", x);
-  return buf;
-}
 
-void SetNodes(const mjModel* m, const mjData* d, const Eigen::Matrix3Xd& x) {
-  double* xp = const_cast<double*>(NodePositions(m, d, 0));
-  ASSERT_NE(xp, nullptr);
-  const int n = GetTether(m, 0)->nodes();
-  ASSERT_EQ(x.cols(), n);
-  for (int i = 0; i < 3 * n; ++i) xp[i] = x.data()[i], xp[3 * n + i] = 0;
-}
 
 // ---------------------------------------------------------------------------------------------
 // Drape: a heavy tether (w = 4.9 N/m) from a fixed site A, up and over a frictionless

@@ -16,11 +16,6 @@
 namespace mjtether::testing {
 namespace {
 
-std::string Fmt(double x) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.10g", x);
-  return buf;
-}
 
 std::string WriteFile(const std::string& name, const std::string& text) {
   const std::string path = ::testing::TempDir() + name;

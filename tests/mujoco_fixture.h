@@ -11,12 +11,31 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
 
 #include "mjtether.h"
 
 namespace mjtether::testing {
+
+// A number as it goes into an MJCF attribute or a declaration: 10 significant digits.
+inline std::string Fmt(double x) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.10g", x);
+  return buf;
+}
+
+// Overwrites the state of tether 0 with node positions x (3 x nodes) at rest (after the first
+// callback set its initial shape).
+inline void SetNodes(const mjModel* m, const mjData* d, const Eigen::Matrix3Xd& x) {
+  double* xp = const_cast<double*>(NodePositions(m, d, 0));
+  ASSERT_NE(xp, nullptr);
+  const int n = GetTether(m, 0)->nodes();
+  ASSERT_EQ(x.cols(), n);
+  for (int i = 0; i < 3 * n; ++i) xp[i] = x.data()[i];
+  for (int i = 0; i < 3 * n; ++i) xp[3 * n + i] = 0;
+}
 
 inline void FailOnWarning(const char* message) {
   ADD_FAILURE() << "MuJoCo warning: " << message;

@@ -13,11 +13,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-std::string Fmt(double x) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.10g", x);
-  return buf;
-}
 
 // ---------------------------------------------------------------------------------------------
 // Wrap: a pile (radius R = 0.3 m, 20 m tall, on the world body) stands at the origin.
