@@ -299,26 +299,30 @@ bool HfieldSegment(const ContactGeom& cg, const Vec3& a, const Vec3& b, double L
   // Samples from the rest length (not the current span), so that their number does not jump.
   const double cell = std::min(2 * h.rx / (h.ncol - 1), 2 * h.ry / (h.nrow - 1));
   const int n = std::clamp(static_cast<int>(std::ceil((hi - lo) * L0 / (0.5 * cell))), 1, 64);
-  Vec3 S0 = Vec3::Zero(), S1 = Vec3::Zero(), mean = Vec3::Zero();
+  // Each sample once: its axis point q and the surface point S under it (on the stack: this
+  // runs per segment per step).
+  constexpr int kMaxSamples = 65;
+  Vec3 q[kMaxSamples], S[kMaxSamples];
+  double at[kMaxSamples];  // the sample's parameter along [a, b]
+  Vec3 mean = Vec3::Zero();
   int count = 0;
-  auto sample = [&](int k, Vec3* q, Vec3* surface, Vec3* normal) {
-    *q = a + (lo + (hi - lo) * k / n) * d;
-    double gap;
-    if (!HfieldGap(cg, *q, &gap, normal)) return false;
-    *surface = Vec3(q->x(), q->y(), q->z() - gap / normal->z());
-    return true;
-  };
   for (int k = 0; k <= n; ++k) {
-    Vec3 q, S, normal;
-    if (!sample(k, &q, &S, &normal)) continue;
-    if (count++ == 0) S0 = S;
-    S1 = S;
+    const double sk = lo + (hi - lo) * k / n;
+    const Vec3 qk = a + sk * d;
+    double gap;
+    Vec3 normal;
+    if (!HfieldGap(cg, qk, &gap, &normal)) continue;
+    q[count] = qk;
+    S[count] = Vec3(qk.x(), qk.y(), qk.z() - gap / normal.z());
+    at[count] = sk;
     mean += normal;
+    ++count;
   }
   if (count == 0) return false;
+  const Vec3& S0 = S[0];
   // The plane's normal: the mean normal without its component along the secant.
   Vec3 nrm = mean.normalized();
-  const Vec3 t = S1 - S0;
+  const Vec3 t = S[count - 1] - S0;
   if (t.squaredNorm() > 1e-24) {
     const Vec3 th = t.normalized();
     const Vec3 across = nrm - nrm.dot(th) * th;
@@ -326,25 +330,51 @@ bool HfieldSegment(const ContactGeom& cg, const Vec3& a, const Vec3& b, double L
   }
   // Lifted over every sample of the surface; the lowest axis point against it.
   double lift = 0;
+  for (int k = 0; k < count; ++k) lift = std::max(lift, nrm.dot(S[k] - S0));
   c->dist = INFINITY;
-  for (int pass = 0; pass < 2; ++pass) {
-    for (int k = 0; k <= n; ++k) {
-      Vec3 q, S, normal;
-      if (!sample(k, &q, &S, &normal)) continue;
-      if (pass == 0) {
-        lift = std::max(lift, nrm.dot(S - S0));
-      } else {
-        const double gap = nrm.dot(q - S0) - lift;
-        if (gap < c->dist) {
-          c->dist = gap;
-          c->s = lo + (hi - lo) * k / n;
-          c->surface = q - gap * nrm;
-        }
-      }
+  for (int k = 0; k < count; ++k) {
+    const double gap = nrm.dot(q[k] - S0) - lift;
+    if (gap < c->dist) {
+      c->dist = gap;
+      c->s = at[k];
+      c->surface = q[k] - gap * nrm;
     }
   }
   c->normal = nrm;
   return true;
+}
+
+// The geom's thinnest half-size [m]: the radius (and a cylinder's half-length), a box's or an
+// ellipsoid's smallest half-size, a mesh hull's depth from its corners' centroid to its nearest
+// face, a height field's smaller cell; 0 for a plane.
+double ThinnestHalfSize(const mjModel* m, const ContactGeom& cg) {
+  const int g = cg.geom;
+  const double* sz = m->geom_size + 3 * g;
+  switch (m->geom_type[g]) {
+    case mjGEOM_SPHERE:
+    case mjGEOM_CAPSULE:
+      return sz[0];
+    case mjGEOM_CYLINDER:
+      return std::min(sz[0], sz[1]);
+    case mjGEOM_BOX:
+    case mjGEOM_ELLIPSOID:
+      return std::min({sz[0], sz[1], sz[2]});
+    case mjGEOM_MESH: {
+      Vec3 c = Vec3::Zero();
+      for (const Vec3& p : cg.hull.corner) c += p;
+      c /= std::max<size_t>(1, cg.hull.corner.size());
+      double thin = INFINITY;
+      for (size_t f = 0; f < cg.hull.normal.size(); ++f) {
+        thin = std::min(thin, cg.hull.offset[f] - cg.hull.normal[f].dot(c));
+      }
+      return std::isfinite(thin) ? std::max(thin, 0.0) : 0;
+    }
+    case mjGEOM_HFIELD:
+      return std::min(2 * cg.hfield.rx / (cg.hfield.ncol - 1),
+                      2 * cg.hfield.ry / (cg.hfield.nrow - 1));
+    default:
+      return 0;
+  }
 }
 
 // The convex hull of mesh `mesh` in its geom's frame (MuJoCo stores a mesh's vertices in
@@ -474,44 +504,7 @@ bool ResolveContactGeoms(const mjModel* m, const std::string& spec, const int si
       cg.hfield_rbound = Vec3(cg.hfield.rx, cg.hfield.ry,
                               std::max(cg.hfield_top, cg.hfield_base)).norm();
     }
-    {
-      // The geom's thinnest half-size: the radius (and a cylinder's half-length), a box's
-      // or an ellipsoid's smallest half-size, a mesh hull's depth from its corners' centroid
-      // to its nearest face, a height field's smaller cell.
-      const double* sz = m->geom_size + 3 * g;
-      double thin = 0;
-      switch (m->geom_type[g]) {
-        case mjGEOM_SPHERE:
-        case mjGEOM_CAPSULE:
-          thin = sz[0];
-          break;
-        case mjGEOM_CYLINDER:
-          thin = std::min(sz[0], sz[1]);
-          break;
-        case mjGEOM_BOX:
-        case mjGEOM_ELLIPSOID:
-          thin = std::min({sz[0], sz[1], sz[2]});
-          break;
-        case mjGEOM_MESH: {
-          Vec3 c = Vec3::Zero();
-          for (const Vec3& p : cg.hull.corner) c += p;
-          c /= std::max<size_t>(1, cg.hull.corner.size());
-          thin = INFINITY;
-          for (size_t f = 0; f < cg.hull.normal.size(); ++f) {
-            thin = std::min(thin, cg.hull.offset[f] - cg.hull.normal[f].dot(c));
-          }
-          thin = std::isfinite(thin) ? std::max(thin, 0.0) : 0;
-          break;
-        }
-        case mjGEOM_HFIELD:
-          thin = std::min(2 * cg.hfield.rx / (cg.hfield.ncol - 1),
-                          2 * cg.hfield.ry / (cg.hfield.nrow - 1));
-          break;
-        default:
-          break;
-      }
-      cg.max_ahead = 0.25 * thin;
-    }
+    cg.max_ahead = 0.25 * ThinnestHalfSize(m, cg);
     // A geom on an end's body is that end's own when the site is inside it or within
     // rho = L0 + d of its surface (the tether starts against it): its segments skip it over the
     // arc that leaves it, the site's depth in it plus rho. Other geoms of that body (a part of
