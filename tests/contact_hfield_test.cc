@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "mujoco_fixture.h"
+#include "slope_scene.h"
 
 namespace mjtether::testing {
 namespace {
@@ -138,11 +139,8 @@ TEST(HfieldContact, RampActsAsTheTiltedPlane) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// (b) Coulomb on a ramp hfield, as contact_test's Resting on a plane: a heavy tether lying down
-// a ramp of angle alpha (the field's heights fall linearly along x), its upper end on a 100 g
-// frictionless slider, friction mu = 0.3. It stays when tan(alpha) < mu (moves less than 3 x the
-// creep of the regularisation, eps atanh(tan(alpha)/mu) per second) and slides 1/2 g (sin(alpha) -
-// mu cos(alpha)) t^2 within 10 % when tan(alpha) > mu (the same bounds and reasons as Resting).
+// (b) Coulomb on a ramp hfield, as contact_test's Resting on a plane (the scene and the bounds:
+// slope_scene.h): the field's heights fall linearly along x, friction mu = 0.3.
 struct RampCase {
   double tan_alpha;
   const char* integrator;
@@ -152,56 +150,17 @@ class HfieldRamp : public ::testing::TestWithParam<RampCase> {};
 
 TEST_P(HfieldRamp, SlidesWhenTanAlphaExceedsMu) {
   const RampCase rc = GetParam();
-  const double mu = 0.3, eps = 0.01, alpha = std::atan(rc.tan_alpha);
-  const double g = 9.81, r = 0.01, M = 0.1;
-  const Vec3 down(std::cos(alpha), 0, -std::sin(alpha)), normal(std::sin(alpha), 0, std::cos(alpha));
+  const Slope sl{std::atan(rc.tan_alpha)};
   // Heights fall from top at x = -rx to 0 at x = rx; the geom placed so that the surface passes
   // through the origin: z = -tan(alpha) x.
   const double rx = 2, ry = 0.5, top = 2 * rx * rc.tan_alpha;
   const std::string field = Hfield("ramp", 5, 81, rx, ry, top, 0.1,
                                    [&](double x, double) { return (rx - x) / (2 * rx); });
-  const Vec3 start = -1.0 * down + r * normal;
-  const std::string xml = R"(
-<mujoco>
-  <option timestep="0.002" gravity="0 0 -9.81"/>
-  <asset>)" + field + R"(</asset>
-  <worldbody>
-    <geom name="ground" type="hfield" hfield="ramp" pos="0 0 )" +
-                          Fmt(-0.5 * top) + R"("/>
-    <body name="slider" pos=")" +
-                          Fmt(start.x()) + " 0 " + Fmt(start.z()) + R"(">
-      <joint name="s" type="slide" axis=")" +
-                          Fmt(down.x()) + " 0 " + Fmt(down.z()) + R"("/>
-      <geom type="sphere" size="0.005" mass=")" +
-                          Fmt(M) + R"(" contype="0" conaffinity="0"/>
-      <site name="a"/>
-    </body>
-  </worldbody>
-  <custom>
-    <text name="tether:t" data="ends=a,free length=2 segments=20 diameter=0.02
-      mass_per_length=2 EA=1e3 damping=1 integrator=)" +
-                          std::string(rc.integrator) + R"( contact=ground contact_friction=)" +
-                          Fmt(mu) + " contact_friction_speed=" + Fmt(eps) + R"("/>
-  </custom>
-</mujoco>)";
-  LoadedScene s(xml);
-  ASSERT_NE(s.d, nullptr);
-  mj_forward(s.m, s.d);
-  const double k = GetTether(s.m, 0)->params().contact_stiffness;
-  const double sink = 2 * g * std::cos(alpha) / k;
-  Eigen::Matrix3Xd x(3, 21);
-  for (int i = 0; i <= 20; ++i) x.col(i) = start + 0.1 * i * down - sink * normal;
-  SetNodes(s.m, s.d, x);
-  while (s.d->time < 1.0) ASSERT_TRUE(s.Step());
-  const double moved = down.dot(Vec3(NodePositions(s.m, s.d, 0) + 30) - x.col(10));
+  const std::string surface =
+      R"(<geom name="ground" type="hfield" hfield="ramp" pos="0 0 )" + Fmt(-0.5 * top) + R"("/>)";
+  const double moved = SlideDownSlope(sl, field, surface, rc.integrator);
   std::printf("hfield ramp tan %.2f %s: moved %.4g m\n", rc.tan_alpha, rc.integrator, moved);
-  if (rc.tan_alpha < mu) {
-    const double creep = eps * std::atanh(rc.tan_alpha / mu);
-    EXPECT_LT(std::abs(moved), 3 * creep * 1.0) << "tan(alpha) < mu: it should stay";
-  } else {
-    const double a = g * (std::sin(alpha) - mu * std::cos(alpha));
-    EXPECT_NEAR(moved, 0.5 * a, 0.1 * 0.5 * a) << "tan(alpha) > mu: it should slide";
-  }
+  ExpectCoulomb(sl, moved);
 }
 
 INSTANTIATE_TEST_SUITE_P(Contact, HfieldRamp,

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "mujoco_fixture.h"
+#include "slope_scene.h"
 
 namespace mjtether::testing {
 namespace {
@@ -233,15 +234,8 @@ INSTANTIATE_TEST_SUITE_P(Contact, NoTunnelling,
                          ::testing::Values("explicit", "rk4", "implicit", "implicit2"));
 
 // ---------------------------------------------------------------------------------------------
-// Resting: a heavy tether lying down a slope of angle alpha (a plane, or the top of a tilted
-// box), held only by friction mu (its upper end on a 100 g frictionless slider along the
-// slope: the slider runs ahead under its own weight and the first segment goes slack, so the
-// tether below is held by nothing else). Coulomb: it stays when tan(alpha) < mu and slides with
-// acceleration g (sin(alpha) - mu cos(alpha)) when tan(alpha) > mu. Staying is "within the
-// regularisation": friction mu N tanh(v/eps) holds the slope at the creep speed v = eps
-// atanh(tan(alpha)/mu), so after 1 s the tether has moved at most about that far (bounded here by 3
-// eps atanh x 1 s). Sliding: the distance after 1 s is 1/2 a t^2 within 10 % (the first instants of
-// settling on the penalty, and the creep scale, are small against 0.3 m).
+// Resting: a heavy tether lying down a slope of angle alpha, a plane or the top of a tilted
+// box, held only by friction (the scene and Coulomb's bounds: slope_scene.h).
 struct SlopeCase {
   const char* geom;
   double tan_alpha;
@@ -251,61 +245,15 @@ class Resting : public ::testing::TestWithParam<std::tuple<SlopeCase, const char
 
 TEST_P(Resting, SlidesWhenTanAlphaExceedsMu) {
   const auto [sc, integrator] = GetParam();
-  const double mu = 0.3, eps = 0.01, alpha = std::atan(sc.tan_alpha);
-  const double g = 9.81, r = 0.01;
-  const double M = 0.1;  // [kg] slider (rk4: coupling omega h = 0.63, below its limit 0.8)
-  // Downhill direction in the x-z plane, surface normal.
-  const Vec3 down(std::cos(alpha), 0, -std::sin(alpha)),
-      normal(std::sin(alpha), 0, std::cos(alpha));
-  const std::string euler = "0 " + Fmt(alpha) + " 0";
+  const Slope sl{std::atan(sc.tan_alpha)};
+  const Vec3 normal = sl.normal();
+  const std::string euler = "0 " + Fmt(sl.alpha) + " 0";
   const std::string surface =
       std::string(sc.geom) == "plane"
           ? R"(<geom name="ground" type="plane" size="10 10 0.1" euler=")" + euler + R"("/>)"
           : R"(<geom name="ground" type="box" size="4 1 0.5" pos=")" + Fmt(-0.5 * normal.x()) +
                 " 0 " + Fmt(-0.5 * normal.z()) + R"(" euler=")" + euler + R"("/>)";
-  const Vec3 start = -1.0 * down + r * normal;  // the upper end, on the surface
-  const std::string xml = R"(
-<mujoco>
-  <option timestep="0.002" gravity="0 0 -9.81"/>
-  <compiler angle="radian"/>
-  <worldbody>
-    )" + surface + R"(
-    <body name="slider" pos=")" +
-                          Fmt(start.x()) + " 0 " + Fmt(start.z()) + R"(">
-      <joint name="s" type="slide" axis=")" +
-                          Fmt(down.x()) + " 0 " + Fmt(down.z()) + R"("/>
-      <geom type="sphere" size="0.005" mass=")" +
-                          Fmt(M) + R"(" contype="0" conaffinity="0"/>
-      <site name="a"/>
-    </body>
-  </worldbody>
-  <custom>
-    <text name="tether:t" data="ends=a,free length=2 segments=20 diameter=0.02
-      mass_per_length=2 EA=1e3 damping=1 integrator=)" +
-                          std::string(integrator) + R"( contact=ground contact_friction=)" +
-                          Fmt(mu) + " contact_friction_speed=" + Fmt(eps) + R"("/>
-  </custom>
-</mujoco>)";
-  LoadedScene s(xml);
-  ASSERT_NE(s.d, nullptr);
-  mj_forward(s.m, s.d);
-  // Lying straight down the slope, touching it (its axis r above the surface, less the
-  // static penetration).
-  const double k = GetTether(s.m, 0)->params().contact_stiffness;
-  const double sink = 2 * g * std::cos(alpha) / k;  // [m] weight per length / stiffness
-  Eigen::Matrix3Xd x(3, 21);
-  for (int i = 0; i <= 20; ++i) x.col(i) = start + 0.1 * i * down - sink * normal;
-  SetNodes(s.m, s.d, x);
-  while (s.d->time < 1.0) ASSERT_TRUE(s.Step());
-  // How far the middle of the tether went down the slope.
-  const double moved = down.dot(Vec3(NodePositions(s.m, s.d, 0) + 30) - x.col(10));
-  if (sc.tan_alpha < mu) {
-    const double creep = eps * std::atanh(sc.tan_alpha / mu);
-    EXPECT_LT(std::abs(moved), 3 * creep * 1.0) << "tan(alpha) < mu: it should stay";
-  } else {
-    const double a = g * (std::sin(alpha) - mu * std::cos(alpha));
-    EXPECT_NEAR(moved, 0.5 * a, 0.1 * 0.5 * a) << "tan(alpha) > mu: it should slide";
-  }
+  ExpectCoulomb(sl, SlideDownSlope(sl, "", surface, integrator));
 }
 
 INSTANTIATE_TEST_SUITE_P(

@@ -34,6 +34,29 @@ std::string Scene(int segments, const char* integrator) {
   return s.str();
 }
 
+// Times `step` (one mj_step and whatever goes with it) from the state in d, restoring that
+// state every `period` steps (outside the timing) so that every batch measures the same motion,
+// and reports seconds per node-step (printed with an SI prefix: "650n" is 650 ns) for a tether
+// of `segments`. Frees d.
+template <class StepFn>
+void TimeRestoring(benchmark::State& state, const mjModel* m, mjData* d, int period, int segments,
+                   StepFn step) {
+  mjData* saved = mj_copyData(nullptr, m, d);
+  int k = 0;
+  for (auto _ : state) {
+    if (++k % period == 0) {
+      state.PauseTiming();
+      mj_copyData(d, m, saved);
+      state.ResumeTiming();
+    }
+    step();
+  }
+  state.counters["per_node_step"] = benchmark::Counter(
+      static_cast<double>(state.iterations()) * (segments + 1),
+      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  mj_deleteData(saved);
+}
+
 void Step(benchmark::State& state, const char* integrator, bool tether) {
   const int segments = static_cast<int>(state.range(0));
   std::string error;
@@ -57,21 +80,7 @@ void Step(benchmark::State& state, const char* integrator, bool tether) {
   mjData* d = mj_makeData(m);
   // Warm up past the initial transient, then restore that state before each batch.
   for (int k = 0; k < 500; ++k) mj_step(m, d);
-  mjData* saved = mj_copyData(nullptr, m, d);
-  int k = 0;
-  for (auto _ : state) {
-    if (++k % 1000 == 0) {
-      state.PauseTiming();
-      mj_copyData(d, m, saved);
-      state.ResumeTiming();
-    }
-    mj_step(m, d);
-  }
-  // Seconds per node per step (printed with an SI prefix: "650n" is 650 ns).
-  state.counters["per_node_step"] = benchmark::Counter(
-      static_cast<double>(state.iterations()) * (segments + 1),
-      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
-  mj_deleteData(saved);
+  TimeRestoring(state, m, d, 1000, segments, [&]() { mj_step(m, d); });
   mj_deleteData(d);
   mjtether::Detach(m);
   mj_deleteModel(m);
@@ -108,23 +117,10 @@ void Line(benchmark::State& state, const char* integrator) {
   };
   const int period = static_cast<int>(std::lround(10 / h));
   for (int k = 0; k < period; ++k) step();
-  mjData* saved = mj_copyData(nullptr, m, d);
-  int k = 0;
-  for (auto _ : state) {
-    if (++k % period == 0) {
-      state.PauseTiming();
-      mj_copyData(d, m, saved);
-      state.ResumeTiming();
-    }
-    step();
-  }
+  TimeRestoring(state, m, d, period, segments, step);
   if (mjtether::CheckDivergence(m, d)) state.SkipWithError("the line diverged");
   state.counters["x_real_time"] = benchmark::Counter(static_cast<double>(state.iterations()) * h,
                                                      benchmark::Counter::kIsRate);
-  state.counters["per_node_step"] = benchmark::Counter(
-      static_cast<double>(state.iterations()) * (segments + 1),
-      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
-  mj_deleteData(saved);
   mj_deleteData(d);
   mjtether::Detach(m);
   mj_deleteModel(m);
