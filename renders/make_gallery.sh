@@ -38,6 +38,11 @@ $M render models/manoeuvre_turn_wrap.xml --duration 30 --fps 10 --speedup 1.5 --
   --camera track:rov --video $R/manoeuvre_turn_wrap_closeup.mp4 \
   --png-every 15 $R/manoeuvre_turn_wrap_closeup
 
+# A tether dragged over a rock (an hfield geom named in contact=, docs/contact.md): small, 20 s.
+$M render models/hfield_rock.xml --duration 20 --fps 10 --size 480x270 \
+  --video $R/hfield_rock.mp4 --png-every 10 $R/hfield_rock
+$M plot models/hfield_rock.xml --duration 20 --out $R/hfield_rock_plot.png
+
 # BlueROV2 Heavy hanging from a heaving boat.
 $M render models/bluerov2_heavy.xml --duration 20 --fps 10 --size 640x360 \
   --video $R/bluerov2_heavy.mp4 --png-every 10 $R/bluerov2_heavy

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "mujoco_fixture.h"
+#include "param_name.h"
 
 namespace mjtether::testing {
 namespace {
@@ -120,7 +121,7 @@ TEST_P(MeshGeom, TetherStaysOutside) {
   EXPECT_LT(lowest, 0.05) << "the tether landed on the mesh";
 }
 
-INSTANTIATE_TEST_SUITE_P(Contact, MeshGeom, ::testing::Values("box", "tetra"));
+INSTANTIATE_TEST_SUITE_P(Contact, MeshGeom, ::testing::Values("box", "tetra"), StringParamName());
 
 // ---------------------------------------------------------------------------------------------
 // An end's own geoms. A geom on the world body 2 m from a world-site end is scenery, not that

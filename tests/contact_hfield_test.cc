@@ -10,12 +10,14 @@
 #include <functional>
 #include <cstdint>
 #include <cstdio>
+#include <ostream>
 #include <string>
 #include <vector>
 
 #include <unistd.h>
 
 #include "mujoco_fixture.h"
+#include "param_name.h"
 #include "slope_scene.h"
 
 namespace mjtether::testing {
@@ -145,6 +147,9 @@ struct RampCase {
   double tan_alpha;
   const char* integrator;
 };
+void PrintTo(const RampCase& c, std::ostream* os) {
+  *os << "tan alpha " << c.tan_alpha << ", " << c.integrator;
+}
 
 class HfieldRamp : public ::testing::TestWithParam<RampCase> {};
 
@@ -167,7 +172,11 @@ INSTANTIATE_TEST_SUITE_P(Contact, HfieldRamp,
                          ::testing::Values(RampCase{0.2, "explicit"}, RampCase{0.45, "explicit"},
                                            RampCase{0.2, "rk4"}, RampCase{0.45, "rk4"},
                                            RampCase{0.2, "implicit"}, RampCase{0.45, "implicit"},
-                                           RampCase{0.2, "bdf2"}, RampCase{0.45, "bdf2"}));
+                                           RampCase{0.2, "bdf2"}, RampCase{0.45, "bdf2"}),
+                         [](const ::testing::TestParamInfo<RampCase>& info) {
+                           return "tan" + NumberName(info.param.tan_alpha) + "_" +
+                                  info.param.integrator;
+                         });
 
 // ---------------------------------------------------------------------------------------------
 // (c), (d) A Gaussian ridge (an hfield on the world body, not the seabed) under a tether hung
@@ -315,7 +324,8 @@ TEST_P(HfieldRidge, RestsOnTheRidge) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Contact, HfieldRidge,
-                         ::testing::Values("implicit", "explicit", "rk4", "implicit2", "bdf2"));
+                         ::testing::Values("implicit", "explicit", "rk4", "implicit2", "bdf2"),
+                         StringParamName());
 
 // ---------------------------------------------------------------------------------------------
 // Declaration: an hfield may be named in contact= (and is in contact=all), but not the seabed

@@ -5,9 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <ostream>
 #include <string>
 
 #include "mujoco_fixture.h"
+#include "param_name.h"
 #include "slope_scene.h"
 
 namespace mjtether::testing {
@@ -30,6 +32,9 @@ struct CapstanCase {
   double mu;
   double theta;
 };
+void PrintTo(const CapstanCase& c, std::ostream* os) {
+  *os << "mu " << c.mu << ", theta " << c.theta / kPi << " pi";
+}
 
 class Capstan : public ::testing::TestWithParam<std::tuple<CapstanCase, const char*>> {};
 
@@ -126,7 +131,12 @@ INSTANTIATE_TEST_SUITE_P(
                                          CapstanCase{0.3, kPi / 2}, CapstanCase{0.5, kPi / 2},
                                          CapstanCase{0.1, kPi}, CapstanCase{0.3, kPi},
                                          CapstanCase{0.5, kPi}),
-                       ::testing::Values("implicit")));
+                       ::testing::Values("implicit")),
+    [](const auto& info) {
+      const CapstanCase& c = std::get<0>(info.param);
+      return "mu" + NumberName(c.mu) + "_theta" + NumberName(c.theta / kPi) + "pi_" +
+             std::get<1>(info.param);
+    });
 
 // ---------------------------------------------------------------------------------------------
 // Two-way: a taut tether (stretched 1 %) carried broadside by a mocap sled at 0.5 m/s sweeps
@@ -180,7 +190,8 @@ TEST_P(TwoWay, BoxMomentumIsMinusTetherContactImpulse) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Contact, TwoWay,
-                         ::testing::Values("explicit", "rk4", "implicit", "implicit2"));
+                         ::testing::Values("explicit", "rk4", "implicit", "implicit2"),
+                         StringParamName());
 
 // ---------------------------------------------------------------------------------------------
 // No tunnelling: a 0.1 m-radius pipe moving at 3 m/s (a 1e4 kg body on a slide, so its speed
@@ -231,7 +242,8 @@ TEST_P(NoTunnelling, PipeAtThreeMetresPerSecond) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Contact, NoTunnelling,
-                         ::testing::Values("explicit", "rk4", "implicit", "implicit2"));
+                         ::testing::Values("explicit", "rk4", "implicit", "implicit2"),
+                         StringParamName());
 
 // ---------------------------------------------------------------------------------------------
 // Resting: a heavy tether lying down a slope of angle alpha, a plane or the top of a tilted
@@ -240,6 +252,9 @@ struct SlopeCase {
   const char* geom;
   double tan_alpha;
 };
+void PrintTo(const SlopeCase& c, std::ostream* os) {
+  *os << c.geom << ", tan alpha " << c.tan_alpha;
+}
 
 class Resting : public ::testing::TestWithParam<std::tuple<SlopeCase, const char*>> {};
 
@@ -260,7 +275,11 @@ INSTANTIATE_TEST_SUITE_P(
     Contact, Resting,
     ::testing::Combine(::testing::Values(SlopeCase{"plane", 0.2}, SlopeCase{"plane", 0.45},
                                          SlopeCase{"box", 0.2}, SlopeCase{"box", 0.45}),
-                       ::testing::Values("explicit", "rk4", "implicit")));
+                       ::testing::Values("explicit", "rk4", "implicit")),
+    [](const auto& info) {
+      const SlopeCase& c = std::get<0>(info.param);
+      return std::string(c.geom) + "_tan" + NumberName(c.tan_alpha) + "_" + std::get<1>(info.param);
+    });
 
 // ---------------------------------------------------------------------------------------------
 // Every supported geom type: a dry 0.6 m tether lowered onto it at 0.6 m/s until its end is
@@ -349,7 +368,8 @@ TEST_P(EveryGeomType, TetherStaysOutside) {
 
 INSTANTIATE_TEST_SUITE_P(Contact, EveryGeomType,
                          ::testing::Values("plane", "sphere", "capsule", "cylinder", "box",
-                                           "ellipsoid"));
+                                           "ellipsoid"),
+                         StringParamName());
 
 // ---------------------------------------------------------------------------------------------
 // Declarations: every key range-checked, unknown names refused with the file, element and key.

@@ -2,7 +2,10 @@
 // and, for numbers, the allowed range.
 #include <gtest/gtest.h>
 
+#include <ostream>
+
 #include "declaration.h"
+#include "param_name.h"
 
 namespace mjtether {
 namespace {
@@ -71,6 +74,7 @@ struct BadCase {
   const char* key;       // the key the message must name
   const char* fragment;  // and a fragment it must contain (the range, the allowed values)
 };
+void PrintTo(const BadCase& c, std::ostream* os) { *os << c.what << ": " << c.text; }
 
 class BadTether : public ::testing::TestWithParam<BadCase> {};
 
@@ -146,7 +150,10 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"EAc negative", With("EAc=2e5", "EAc=-2e5"), "EAc", "(0, 1e+13]"},
         BadCase{"EAc huge", With("EAc=2e5", "EAc=1e14"), "EAc", "(0, 1e+13]"},
         BadCase{"compression without EAc", With("EAc=2e5 ", "") + " effects=axial,compression",
-                "effects", "EAc > 0"}));
+                "effects", "EAc > 0"}),
+    [](const ::testing::TestParamInfo<BadCase>& info) {
+      return testing::ParamName(info.param.what);
+    });
 
 TEST(Declaration, MalformedTextIsRejected) {
   DeclarationError e;

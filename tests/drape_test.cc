@@ -7,6 +7,7 @@
 #include <string>
 
 #include "mujoco_fixture.h"
+#include "param_name.h"
 
 namespace mjtether::testing {
 namespace {
@@ -119,7 +120,8 @@ TEST_P(Drape, EquilibriumAsStaticsPredicts) {
   EXPECT_NEAR(TA / expected, 1, 0.01) << "T_A " << TA << " expected " << expected;
 }
 
-INSTANTIATE_TEST_SUITE_P(Integrators, Drape, ::testing::Values("implicit", "explicit"));
+INSTANTIATE_TEST_SUITE_P(Integrators, Drape, ::testing::Values("implicit", "explicit"),
+                         StringParamName());
 
 }  // namespace
 }  // namespace mjtether::testing

@@ -9,9 +9,11 @@
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <ostream>
 #include <string>
 
 #include "mujoco_fixture.h"
+#include "param_name.h"
 
 namespace mjtether::testing {
 namespace {
@@ -187,7 +189,8 @@ TEST_P(ShearedCurrent, StaticShapeMatchesIntegratedEquilibrium) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Integrators, ShearedCurrent,
-                         ::testing::Values("implicit", "implicit2", "explicit", "rk4"));
+                         ::testing::Values("implicit", "implicit2", "explicit", "rk4"),
+                         StringParamName());
 
 // The reference is sensitive to the profile: the same ODE with the depth-averaged current
 // taken uniform moves the lower end by more than the tolerance above, so a tether that saw
@@ -224,7 +227,8 @@ TEST_P(UniformProfile, EqualsUniformCurrent) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Integrators, UniformProfile,
-                         ::testing::Values("implicit", "implicit2", "explicit", "rk4"));
+                         ::testing::Values("implicit", "implicit2", "explicit", "rk4"),
+                         StringParamName());
 
 // Declaration errors: exclusive with a non-zero current; the file is named.
 TEST(CurrentProfileDeclaration, Refusals) {
@@ -261,6 +265,9 @@ struct PlaneCase {
   double tan_alpha;
   const char* integrator;
 };
+void PrintTo(const PlaneCase& c, std::ostream* os) {
+  *os << "tan alpha " << c.tan_alpha << ", " << c.integrator;
+}
 
 class SeabedPlane : public ::testing::TestWithParam<PlaneCase> {};
 
@@ -323,7 +330,11 @@ INSTANTIATE_TEST_SUITE_P(Cases, SeabedPlane,
                                            PlaneCase{0.2, "implicit2"},
                                            PlaneCase{0.45, "implicit2"}, PlaneCase{0.2, "explicit"},
                                            PlaneCase{0.45, "explicit"}, PlaneCase{0.2, "rk4"},
-                                           PlaneCase{0.45, "rk4"}));
+                                           PlaneCase{0.45, "rk4"}),
+                         [](const ::testing::TestParamInfo<PlaneCase>& info) {
+                           return "tan" + NumberName(info.param.tan_alpha) + "_" +
+                                  info.param.integrator;
+                         });
 
 // Height field: models/seabed_hfield.xml (a sloping, rough hfield from a PNG, a 60 m tether
 // lying on it) settles, and every node is on or above the surface within the static
@@ -424,7 +435,8 @@ TEST_P(SeabedHfield, NodesRestOnTheSurface) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Integrators, SeabedHfield,
-                         ::testing::Values("implicit", "implicit2", "explicit", "rk4"));
+                         ::testing::Values("implicit", "implicit2", "explicit", "rk4"),
+                         StringParamName());
 
 // Declaration: seabed=NAME must name a plane or hfield fixed in the world; a bad name is
 // reported with the key.

@@ -15,6 +15,7 @@
 #include "catenary_reference.h"
 #include "mujoco_fixture.h"
 #include "mjtether.h"
+#include "param_name.h"
 
 namespace mjtether {
 namespace {
@@ -132,7 +133,7 @@ TEST_P(PendulumTest, PeriodMatchesClosedForm) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Integrators, PendulumTest,
-                         ::testing::Values("Euler", "implicit", "RK4"));
+                         ::testing::Values("Euler", "implicit", "RK4"), testing::StringParamName());
 
 // Euler, implicit and RK4 give the same trajectory: after 3 s (about one period) the bob's
 // positions agree to 1 mm, the size of the O(h) difference between the schemes at h = 1 ms.

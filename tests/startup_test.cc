@@ -12,6 +12,7 @@
 #include <string>
 
 #include "mujoco_fixture.h"
+#include "param_name.h"
 
 namespace mjtether {
 namespace {
@@ -133,7 +134,8 @@ TEST_P(StartUp, SeabedThroughTheCatenaryStartsOnItAndRuns) {
   RunAndCheckPenetration(m, d, seabed, 2.0);
 }
 
-INSTANTIATE_TEST_SUITE_P(Integrators, StartUp, ::testing::ValuesIn(kIntegrators));
+INSTANTIATE_TEST_SUITE_P(Integrators, StartUp, ::testing::ValuesIn(kIntegrators),
+                         testing::StringParamName());
 
 // ---------------------------------------------------------------------------------------------
 // Refused at load (CLI exit code 2, cause named) and warned about.

@@ -20,6 +20,7 @@
 #include "mujoco_fixture.h"
 #include "make_tether.h"
 #include "tether.h"
+#include "param_name.h"
 
 namespace mjtether {
 namespace {
@@ -621,7 +622,11 @@ INSTANTIATE_TEST_SUITE_P(Stress, SnapLoad,
                                             ::testing::Values(Integrator::kImplicit,
                                                               Integrator::kExplicit,
                                                               Integrator::kRK4, Integrator::kImplicit2,
-                                                              Integrator::kBdf2)));
+                                                              Integrator::kBdf2)),
+                         [](const auto& info) {
+                           return "EA" + testing::NumberName(std::get<0>(info.param)) + "_" +
+                                  Name(std::get<1>(info.param));
+                         });
 
 // A vehicle (mocap body, moved by the test) with the tether 0.5 m off its axis, in water with
 // a heavy tether hanging 8 m from a fixed TMS. After settling it spins at 2 rev/s (the end at

@@ -3,7 +3,7 @@
 # DATA holds the driver's <scene>_<series>.dat (columns: CPU ms per simulated second, end
 # tension error against the finest reference [N], time-only error [N], segments, step [ms]),
 # <scene>_<series>_front.dat (that series' Pareto front) and <scene>_front.dat (the scene's).
-set terminal pngcairo size 1400,560 font ",10"
+set terminal pngcairo size 1400,740 font ",10"
 set datafile missing "nan"
 set logscale xy
 set format x "10^{%L}"
@@ -24,7 +24,9 @@ set multiplot layout 1,2 title "Fixed line: 100 m, EA 1e6 N, fairlead x = 80 + 2
 set xlabel "CPU time per simulated second [ms] (one core)"
 set ylabel "end tension error [N]"
 set yrange [0.004:1e3]
-set key bottom left box opaque
+set bmargin 11
+# Keys below the panels: inside, any corner covers runs (the bottom left held the Pareto front).
+set key at graph 0.5, graph -0.13 center top horizontal maxcols 3 box
 stats file("line_mean") using 1 nooutput
 meanT = STATS_min
 set title sprintf("all segment counts (10-320) against 640 segments converged; mean tension %.0f N", meanT)
@@ -45,7 +47,7 @@ unset arrow 2
 set title "80 segments: time error only (against 80 segments converged in time)"
 set ylabel "end tension error, time discretisation only [N]"
 set yrange [1e-4:1e3]
-set key top right box opaque
+set key at graph 0.5, graph -0.13 center top horizontal maxcols 3 box
 set object 1 rect from graph 0, first 1e-9 to first 6, first 0.02 fc rgb "#2ca02c" fs transparent solid 0.12 noborder
 set object 2 rect from graph 0, first 1e-9 to first 3, first 6 fc rgb "#1f77b4" fs transparent solid 0.08 noborder
 set label 3 "target: 0.02 N in 6 ms" at first 6, first 0.02 right offset -0.5,-0.8 front
@@ -58,6 +60,9 @@ unset object 2
 unset label 3
 unset label 4
 unset multiplot
+unset bmargin
+set key default
+set key top right box opaque
 
 set terminal pngcairo size 1400,1000 font ",10"
 set output sprintf("%s/accuracy_cost_scenes.png", out)

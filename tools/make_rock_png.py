@@ -1,0 +1,50 @@
+#!/usr/bin/env python3
+"""Writes models/hfield_rock.png, the height map of the rock in models/hfield_rock.xml: a
+rounded boulder (a squashed dome over an ellipse of half-axes 0.95 and 0.75 of the field's
+half-sizes, zero outside it) with a few gentle bumps on it (a sum of sines, deterministic,
++-6 % of the elevation). 8-bit grey, 61 x 61 pixels, lowest pixel 0 and highest 255, so that
+MuJoCo's grey 0..255 -> 0..elevation (the hfield's size[2]) is the whole scale.
+
+Usage: python3 tools/make_rock_png.py [OUT.png]   (only python3 and zlib)
+"""
+import math
+import struct
+import sys
+import zlib
+
+N = 61
+
+
+def height(i, j):
+    """Height in [0, 1] at column i (along x) and image row j, before the final scaling."""
+    x, y = 2 * i / (N - 1) - 1, 2 * j / (N - 1) - 1  # -1..1 across the field
+    r2 = (x / 0.95) ** 2 + (y / 0.75) ** 2
+    if r2 >= 1:
+        return 0.0
+    dome = (1 - r2) ** 0.7
+    bumps = 0.06 * (math.sin(2 * math.pi * (1.5 * x + 0.1)) * math.cos(2 * math.pi * 1.2 * y)
+                    + 0.5 * math.sin(2 * math.pi * (2.5 * x - 1.7 * y)))
+    return max(0.0, dome * (1 + bumps))
+
+
+def png(width, height_, rows):
+    def chunk(kind, data):
+        c = struct.pack(">I", len(data)) + kind + data
+        return c + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+    raw = b"".join(b"\x00" + bytes(r) for r in rows)  # filter 0 on every row
+    return (b"\x89PNG\r\n\x1a\n"
+            + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height_, 8, 0, 0, 0, 0))
+            + chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b""))
+
+
+def main():
+    out = sys.argv[1] if len(sys.argv) > 1 else "models/hfield_rock.png"
+    h = [[height(i, j) for i in range(N)] for j in range(N)]
+    top = max(max(r) for r in h)
+    rows = [[round(255 * v / top) for v in r] for r in h]
+    with open(out, "wb") as f:
+        f.write(png(N, N, rows))
+
+
+if __name__ == "__main__":
+    main()
