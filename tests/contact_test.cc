@@ -363,7 +363,9 @@ TEST_P(EveryGeomType, TetherStaysOutside) {
   const double* x = NodePositions(s.m, s.d, 0);
   double lowest = INFINITY;
   for (int i = 0; i <= 15; ++i) lowest = std::min(lowest, sdf(Vec3(x + 3 * i)));
-  if (type != "ellipsoid") EXPECT_LT(lowest, 0.05);
+  if (type != "ellipsoid") {
+    EXPECT_LT(lowest, 0.05);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Contact, EveryGeomType,
