@@ -1543,8 +1543,8 @@ std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d) {
            "internal and seabed damping) changes by "
         << lambda_D << " N per m/s, which the body, through MuJoCo's explicit step, feels as h "
         << "lambda = " << rate << " > " << limit
-        << " (the body's velocity would oscillate and grow every step; MuJoCo would report a "
-           "huge QACC and reset). ";
+        << " (the body's velocity would reverse every step, and grow where a force such as a "
+           "thrust holds it at that speed, until MuJoCo reports a huge QACC and resets). ";
       if (at.limit[end].omega_h >= 1) {
         s << "The end segment's stiffness also couples strongly: omega h = "
           << at.limit[end].omega_h << " >= 1 at this body (docs/coupling.md). ";

@@ -24,7 +24,9 @@
 //   diverged     stops with a divergence message whose cause this file checks: thrust beyond
 //                EA x max_strain, ends pulled beyond length x (1 + max_strain), an end moving
 //                more than half of max_strain L0 per step, an end below the seabed, a stretched
-//                start; a coupling chatter (the run-time work balance) where omega h is at
+//                start; an end damping too stiff for the vehicle's step (h lambda > 2, from
+//                an upper bound of the end's drag and damping); a coupling chatter (the
+//                run-time work balance) where omega h is at
 //                least half the advisor's limit; or, where the message blames the step, the
 //                same scene at a 10x smaller step runs to the end.
 // Anything else is a failure: a refusal or divergence whose cause does not hold, a scene that
