@@ -68,12 +68,18 @@ enum CoupleSlot : int {
   kEnergyScale = 1,  // [J] largest kinetic energy of the site + elastic energy of the end seen
   kBodyWork = 2,     // [J] work the end did on the body (for the message)
   kCoupleSteps = 3,  // [-] steps checked
-  kCoupleSpare = 4,
+  kDampingRate = 4,  // [-] h lambda of the end's damping on the body (CheckEndDamping)
   kCoupleSize = 5,
 };
 
 // Divergence codes in kStatus.
-enum Divergence : int { kNonFinite = 1, kStrain = 2, kKinetic = 3, kChatter = 4 };
+enum Divergence : int {
+  kNonFinite = 1,
+  kStrain = 2,
+  kKinetic = 3,
+  kChatter = 4,
+  kEndDamping = 5,  // the end's velocity-dependent force too stiff for the body's step
+};
 
 struct AttachedTether {
   AttachedTether(std::string n, Tether t) : name(std::move(n)), tether(std::move(t)) {}
@@ -487,6 +493,140 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
   }
 }
 
+// The velocity-dependent part of the force an end puts on its body (the end node's drag with
+// its half-segments' length, the end segment's internal damping, the seabed's damping) enters
+// MuJoCo's step explicitly, like every force from mjcb_passive: with D = -sym(dF/dv) at the
+// site and W = J M^-1 J^T the body's inverse mass there, a body velocity mode decays by the
+// factor 1 - h lambda per step, lambda the largest eigenvalue of W^1/2 D W^1/2, and grows
+// (alternating in sign) once h lambda > 2 (semi-implicit Euler and MuJoCo's implicit
+// integrator, which does not see the callback's derivatives; RK4: 2.785, the real-axis
+// stability limit of the classical RK4). Quadratic drag makes D grow with the speed: a light
+// vehicle driven fast across its tether (a thrust of the order of EA) reaches it, and before
+// this check MuJoCo reported "Nan, Inf or huge value in QACC" and reset the data (the scene
+// fuzzer's open-thrust-qacc class: h lambda crossed 2 3-48 steps before MuJoCo's warning on
+// seeds 186, 255, 611, 977, 3806). D by central differences of Reactions in the end's velocity
+// (a 3-node window: the cost of three reactions per moving end and call).
+constexpr double kEndDampingLimitEuler = 2.0;
+constexpr double kEndDampingLimitRk4 = 2.785;
+
+// h lambda for end `end` of `at` in its state at the tether's time, and D's largest eigenvalue
+// [N s/m] and the speed of the site relative to the water [m/s] (for the message).
+double EndDampingRate(const mjModel* m, mjData* d, const AttachedTether& at, int end,
+                      double* work, double* jac, double* lambda_D = nullptr,
+                      double* speed = nullptr) {
+  double* u = d->userdata + at.offset;
+  const Tether& t = at.tether;
+  const double* x = u + kHeader;
+  double* v = u + kHeader + 3 * t.nodes();
+  Ends e{LoadEnd(u + kEndA), LoadEnd(u + kEndB)};
+  EndState& es = end == 0 ? e.a : e.b;
+  const double dv = 1e-6 * (1 + es.vel.norm());  // [m/s]
+  // The end node and its neighbour perturbed together (restored after): the end segment's
+  // internal damping acts on their relative velocity, which the tether's own step relaxes
+  // (its interior follows the end within the step), so only the end node's own laws (drag,
+  // seabed) act on the body at the MuJoCo step. (The Drape test's body at rest on an implicit
+  // tether with damping read h lambda = 2.02 from the internal damping alone, and is stable.)
+  double* vn = v + 3 * (end == 0 ? 1 : t.segments() - 1);
+  Mat3 J;
+  for (int c = 0; c < 3; ++c) {
+    const double keep = es.vel[c], keep_n = vn[c];
+    es.vel[c] = keep + dv;
+    vn[c] = keep_n + dv;
+    const EndReactions rp = t.Reactions(x, v, e, work);
+    es.vel[c] = keep - dv;
+    vn[c] = keep_n - dv;
+    const EndReactions rm = t.Reactions(x, v, e, work);
+    es.vel[c] = keep;
+    vn[c] = keep_n;
+    J.col(c) = ((end == 0 ? rp.force_a : rp.force_b) - (end == 0 ? rm.force_a : rm.force_b)) /
+               (2 * dv);
+  }
+  const Mat3 D = -0.5 * (J + J.transpose());
+  const Mat3 W = SiteInverseMass(m, d, at.site[end], jac);
+  Eigen::SelfAdjointEigenSolver<Mat3> ew(W);
+  const Mat3 Wh = ew.eigenvectors() * ew.eigenvalues().cwiseMax(0).cwiseSqrt().asDiagonal() *
+                  ew.eigenvectors().transpose();
+  const double lambda = Eigen::SelfAdjointEigenSolver<Mat3>(Wh * D * Wh, Eigen::EigenvaluesOnly)
+                            .eigenvalues()
+                            .maxCoeff();
+  if (lambda_D) {
+    *lambda_D = Eigen::SelfAdjointEigenSolver<Mat3>(D, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
+  }
+  if (speed) {
+    const Vec3 current = t.env().water.current;  // (a profile: its value at z = 0)
+    *speed = (es.vel - current).norm();
+  }
+  return m->opt.timestep * lambda;
+}
+
+// An upper bound of D's largest eigenvalue at end `end` [N s/m], from the declared laws, so that
+// the exact figure (six reactions, measured at 15-30 us a call against a 50-100 us step of a
+// 10-segment tether) is computed only near the limit: the end node's drag, whose derivative is
+// at most 2 max(kn, kt) (l/2) |v_r| (AddDrag: kn = rho Cdn d / 2, kt = rho Cdt pi d / 2, drag
+// length l/2 for the end segment's length l now, v_r relative to the current), here with l;
+// the end segment's internal damping, damping / L0; a flat seabed under the end node, its
+// damping c over the node's share (< L0) and its friction's slope mu N / eps (tanh law, N at
+// most L0 (k pen + c |v_z|)). Infinite (no bound: always the exact figure) with contact, a
+// seabed geom or a current profile.
+double EndDampingBound(const AttachedTether& at, const double* u, int end) {
+  const Tether& t = at.tether;
+  const TetherParams& p = t.params();
+  const Environment& env = t.env();
+  const Water& w = env.water;
+  if ((p.effects & kContact) || ((p.effects & kSeabed) && w.surface.declared()) ||
+      ((p.effects & kCurrent) && !w.profile.empty())) {
+    return INFINITY;
+  }
+  const double* x = u + kHeader;
+  const int e = end == 0 ? 0 : t.segments(), n = end == 0 ? 1 : t.segments() - 1;
+  const Vec3 xe(x + 3 * e), xn(x + 3 * n);
+  const double l = (xe - xn).norm(), L0 = t.rest_segment_length();  // [m]
+  const EndState es = LoadEnd(u + (end == 0 ? kEndA : kEndB));
+  const Vec3 current = (p.effects & kCurrent) ? w.current : Vec3::Zero();
+  const double rho = env.wet ? w.density : 0;
+  double D = 0;
+  if (p.effects & kDrag) {
+    const double k = 0.5 * rho * p.diameter * std::max(p.Cdn, 3.14159265358979323846 * p.Cdt);
+    D += 2 * k * l * (es.vel - current).norm();
+  }
+  if (p.effects & kDamping) D += p.damping / L0;
+  if ((p.effects & kSeabed) && xe.z() > w.seabed - 1e3 * L0) {
+    const double c = w.seabed_damping >= 0 ? w.seabed_damping
+                                            : 2 * std::sqrt(w.seabed_stiffness * p.mass_per_length);
+    const double pen = std::max(0.0, w.seabed - xe.z());
+    const double N = L0 * (w.seabed_stiffness * pen + c * std::abs(es.vel.z()));
+    const double mu = std::max(w.seabed_friction, w.seabed_friction_axial);
+    D += c * L0 + (mu > 0 ? mu * N / w.seabed_friction_speed : 0);
+  }
+  return D;
+}
+
+// After Evaluate: stops the tether (status kEndDamping) before its end's damping makes the body
+// oscillate without bound. Not for a winch (its end A reacts through a deployed view).
+void CheckEndDamping(const mjModel* m, mjData* d, const AttachedTether& at, double* work,
+                     double* jac) {
+  double* u = d->userdata + at.offset;
+  if (u[kStatus] != 0 || u[kInitialized] == 0 || at.winch) return;
+  const double limit =
+      m->opt.integrator == mjINT_RK4 ? kEndDampingLimitRk4 : kEndDampingLimitEuler;
+  for (int end = 0; end < 2; ++end) {
+    if (at.site[end] < 0 || !at.coupled[end]) continue;
+    // The bound on the load-time effective mass (1 / the largest eigenvalue of W, the same in
+    // every orientation of a free body), with a factor 2 for bodies whose W changes with their
+    // joints' configuration.
+    const double m_eff = at.limit[end].m_eff;
+    if (m_eff > 0 && m->opt.timestep * EndDampingBound(at, u, end) / m_eff < 0.5 * limit) continue;
+    const double rate = EndDampingRate(m, d, at, end, work, jac);
+    if (rate > limit) {
+      u[(end == 0 ? kCoupleA : kCoupleB) + kDampingRate] = rate;
+      u[kStatus] = kEndDamping;
+      u[kBadNode] = end == 0 ? 0 : at.tether.segments();
+      u[kBadTime] = d->time;
+      return;
+    }
+  }
+}
+
 void Passive(const mjModel* m, mjData* d) {
   if (g_previous_passive) g_previous_passive(m, d);
   ApplyVehicles(m, d);  // vehicle:BODY declarations (plugin/vehicles.cc)
@@ -495,7 +635,10 @@ void Passive(const mjModel* m, mjData* d) {
   mjMARKSTACK;
   double* work = mj_stackAlloc(d, set->work_size);
   double* jac = mj_stackAlloc(d, 6 * std::max(set->nv, 1));
-  for (const AttachedTether& at : set->tethers) Evaluate(m, d, at, work, jac);
+  for (const AttachedTether& at : set->tethers) {
+    Evaluate(m, d, at, work, jac);
+    CheckEndDamping(m, d, at, work, jac);
+  }
   mjFREESTACK;
 }
 
@@ -1436,6 +1579,41 @@ std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d) {
       // (Checked for explicit and rk4 tethers only.)
       s << "Use integrator=implicit or implicit2, or <option timestep> <= " << c.limit / c.omega
         << " s.";
+      return s.str();
+    }
+    if (u[kStatus] == kEndDamping) {
+      const int end = u[kBadNode] == 0 ? 0 : 1;
+      const double rate = u[(end == 0 ? kCoupleA : kCoupleB) + kDampingRate];
+      std::vector<double> work(set->work_size), jac(6 * std::max(m->nv, 1));
+      double lambda_D = 0, speed = 0;
+      // The state is as it was stopped (the tether stays inert): the figures again, for the text.
+      EndDampingRate(m, const_cast<mjData*>(d), at, end, work.data(), jac.data(), &lambda_D,
+                     &speed);
+      const char* body = mj_id2name(m, mjOBJ_BODY, at.body[end]);
+      const double limit =
+          m->opt.integrator == mjINT_RK4 ? kEndDampingLimitRk4 : kEndDampingLimitEuler;
+      s << set->source << ": tether '" << at.name << "' stopped at t = " << u[kBadTime]
+        << " s: its end " << (end == 0 ? "A" : "B") << " damping too stiff for the step of body '"
+        << (body ? body : "?") << "': moving at " << speed
+        << " m/s through the water, the end node's own velocity-dependent force (its drag, "
+           "seabed damping and friction) changes by "
+        << lambda_D << " N per m/s, which the body, through MuJoCo's explicit step, feels as h "
+        << "lambda = " << rate << " > " << limit
+        << " (the body's velocity would reverse every step, and grow where a force such as a "
+           "thrust holds it at that speed, until MuJoCo reports a huge QACC and resets). ";
+      if (at.limit[end].omega_h >= 1) {
+        s << "The end segment's stiffness also couples strongly: omega h = "
+          << at.limit[end].omega_h << " >= 1 at this body (docs/coupling.md). ";
+      }
+      const std::string cause = Diagnose(m, d, set->env, at, u);
+      if (!cause.empty()) {
+        s << "It was driven there by: " << cause << ". ";
+      } else if (const double thrust = ThrustOn(m, d, at.body[end]); thrust > 0) {
+        s << "The actuators push body '" << (body ? body : "?") << "' with " << thrust << " N. ";
+      }
+      s << "Reduce <option timestep> below " << m->opt.timestep * limit / rate
+        << " s, or reduce what drives the body that fast (thrust, motion), or make the body "
+           "heavier.";
       return s.str();
     }
     s << set->source << ": tether '" << at.name << "' diverged at t = " << u[kBadTime]

@@ -24,7 +24,9 @@
 //   diverged     stops with a divergence message whose cause this file checks: thrust beyond
 //                EA x max_strain, ends pulled beyond length x (1 + max_strain), an end moving
 //                more than half of max_strain L0 per step, an end below the seabed, a stretched
-//                start; a coupling chatter (the run-time work balance) where omega h is at
+//                start; an end damping too stiff for the vehicle's step (h lambda > 2, from
+//                an upper bound of the end's drag and damping); a coupling chatter (the
+//                run-time work balance) where omega h is at
 //                least half the advisor's limit; or, where the message blames the step, the
 //                same scene at a 10x smaller step runs to the end.
 // Anything else is a failure: a refusal or divergence whose cause does not hold, a scene that
@@ -461,6 +463,21 @@ Outcome JudgeRuns(const Scene& s) {
     const double span = (coarse.vehicle - coarse.tms).norm();
     const double fast = 0.5 * 1.0 * s.L0() / kStep;  // [m/s] speed the message refers to
     const double tms_speed = 2 * kPi * s.motion_amp / s.motion_period;  // [m/s] upper bound
+    if (Contains(msg, "damping too stiff for the step")) {
+      // CheckEndDamping (plugin/plugin.cc): h lambda > 2 for the end's velocity-dependent force
+      // on the vehicle. Recomputed as an upper bound from the scene: D <= the end node's drag,
+      // 2 max(kn, kt) l |v_r| with its drag length l = half the end segment <= L0 (the run had
+      // not diverged by strain, so the segment is at most 2 L0) and |v_r| <= |v_vehicle| + |U|;
+      // plus the internal damping damping / L0 and the seabed's critical damping
+      // 2 sqrt(k mu) (default k = 1e5 N/m^2) over the end's share L0 / 2; on the effective mass
+      // m + a_min (the site at the vehicle's centre of mass, docs/coupling.md).
+      const double kn = 0.5 * kRho * 1.2 * s.diameter, kt = 0.5 * kRho * 0.01 * kPi * s.diameter;
+      const double v_r = coarse.vehicle_speed + s.current.norm();
+      double D = 2 * std::max(kn, kt) * s.L0() * v_r + s.damping / s.L0();
+      if (s.seabed_kind != 0) D += 2 * std::sqrt(1e5 * s.mpl) * s.L0() / 2;
+      const double bound = kStep * D / (s.mass + s.added_min);
+      return {"diverged: end damping too stiff for the step (h lambda > 2)", bound > 2, msg};
+    }
     if (Contains(msg, "thrust beyond what the tether holds")) {
       return {"diverged: thrust beyond EA x max_strain", s.thrust >= s.holds(), msg};
     }
