@@ -487,21 +487,74 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   newton = true;
   for (int iter = 1; err > tolerance; ++iter) {
     if (iter == kMaxNewton) return false;
+    dv = rhs;  // -G at the iterate, for E'(0) below
     if (!solve()) return fail();
+    double g0 = 0;  // E'(0) = d . G(v) = -d^T A d < 0
+    for (int u = 0; u < nu; ++u) g0 -= rhs.col(u).dot(dv.col(u));
     dv = rhs;
     for (int i = 1; i <= nu; ++i) vb.col(i - 1) = vk.col(i);
     for (int i = 1; i <= nu; ++i) vk.col(i) += dv.col(i - 1);
     place();
     if (linearisation_held()) break;
-    // Backtracking (Armijo, sigma = 1e-4): phi(alpha) <= (1 - 2 sigma alpha) phi(0), the
-    // directional derivative of phi along an exact Newton step being -2 phi(0).
+    // Line search: backtracking (Armijo, sigma = 1e-4) on phi, phi(alpha) <= (1 - 2 sigma
+    // alpha) phi(0), the directional derivative of phi along an exact Newton step being
+    // -2 phi(0), halving alpha from 1 down to kMinLineSearchStep.
+    // Where that fails, on the incremental potential instead: for the conservative forces, and
+    // the damping in its discrete form (a function of the lengths), G is the gradient of
+    // E(v+) = 1/2 (v+ - v)^T M (v+ - v) + U(x + h v+) (backward Euler as a minimisation: Gast
+    // et al., IEEE TVCG 21, 2015), whose derivative along the Newton direction d is
+    // E'(alpha) = d . G(v + alpha d), E'(0) = -d^T A d < 0. A Newton step that crosses a kink
+    // (a slack segment coming taut, with the matrix of the slack piece) overshoots by the ratio
+    // of the stiffnesses, ~(h^2 EA/L0 + h damping/L0)/m, up to 1e3 on short heavily damped
+    // segments: phi rises within a fraction of the step below kMinLineSearchStep. E' is
+    // still monotone along the ray (E convex there), so the minimum of E along d is bracketed
+    // by the alphas tried, and regula falsi (Illinois) on E' finds a point where
+    // |E'(alpha)| <= kCurvature |E'(0)| (the strong Wolfe curvature condition; Nocedal &
+    // Wright, ch. 3), which lowers E. Steps that Armijo takes are taken as before.
     double alpha = 1, trial = 0;
+    double lo = 0, g_lo = g0, hi = 1, g_hi = NAN;  // the bracket on E' from the alphas tried
+    // E'(alpha) from the residual just evaluated.
+    auto slope = [&]() {
+      double g = 0;
+      for (int u = 0; u < nu; ++u) g -= dv.col(u).dot(rhs.col(u));
+      return g;
+    };
+    bool armijo = false;
     for (;;) {
       trial = residual(&err);
-      if (trial <= (1 - 2e-4 * alpha) * phi) break;
+      if (trial <= (1 - 2e-4 * alpha) * phi) {
+        armijo = true;
+        break;
+      }
+      const double g = slope();
+      if (g < 0 && alpha > lo) lo = alpha, g_lo = g;
+      if (g >= 0 && alpha <= hi) hi = alpha, g_hi = g;
       alpha *= 0.5;
-      if (alpha < kMinLineSearchStep) return false;
+      if (alpha < kMinLineSearchStep) break;
       for (int i = 1; i <= nu; ++i) vk.col(i) = vb.col(i - 1) + alpha * dv.col(i - 1);
+    }
+    if (!armijo) {
+      if (!std::isfinite(g_hi) || !(lo < hi)) return false;  // no bracket: retry in halves
+      // Illinois: which end of the bracket was kept last.
+      int side = 0;
+      for (int evaluations = 0;; ++evaluations) {
+        if (evaluations == kMaxLineSearch) return false;
+        alpha = lo + (hi - lo) * g_lo / (g_lo - g_hi);
+        if (!(alpha > 0)) return false;
+        for (int i = 1; i <= nu; ++i) vk.col(i) = vb.col(i - 1) + alpha * dv.col(i - 1);
+        trial = residual(&err);
+        const double g = slope();
+        if (std::abs(g) <= kCurvature * std::abs(g0)) break;
+        if (g < 0) {
+          lo = alpha, g_lo = g;
+          if (side == -1) g_hi *= 0.5;
+          side = -1;
+        } else {
+          hi = alpha, g_hi = g;
+          if (side == 1) g_lo *= 0.5;
+          side = 1;
+        }
+      }
     }
     phi = trial;
   }

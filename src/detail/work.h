@@ -25,6 +25,12 @@ constexpr double kLinearisationTolerance = 0.01;
 constexpr double kNewtonTolerance = 1e-2;
 constexpr int kMaxNewton = 12;
 constexpr double kMinLineSearchStep = 1.0 / 64;
+// Where that backtracking fails, the line search takes a point along the Newton direction
+// where the derivative of the step's incremental potential has fallen to this fraction of its
+// value at the start (the strong Wolfe curvature condition; see ImplicitStep), with at most
+// kMaxLineSearch more residual evaluations.
+constexpr double kCurvature = 0.5;
+constexpr int kMaxLineSearch = 8;
 // bdf2 restarts with a backward-Euler step when the step grows by more than this ratio over
 // the last (variable-step BDF2 is zero-stable below 1 + sqrt(2); docs/numerics.md).
 constexpr double kBdf2MaxRatio = 2;
