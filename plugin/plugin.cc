@@ -69,7 +69,8 @@ enum CoupleSlot : int {
   kBodyWork = 2,     // [J] work the end did on the body (for the message)
   kCoupleSteps = 3,  // [-] steps checked
   kDampingRate = 4,  // [-] h lambda of the end's damping on the body (CheckEndDamping)
-  kCoupleSize = 5,
+  kLeadTime = 5,     // [s] end B of a lead tether: the time its state is at (see EvaluateLead)
+  kCoupleSize = 6,
 };
 
 // Divergence codes in kStatus.
@@ -95,6 +96,11 @@ struct AttachedTether {
   // force explicitly over its step (docs/coupling.md).
   bool coupled[2] = {false, false};
   CouplingLimit limit[2];  // the time-step advisor's figures at load time
+  // The consistent coupling (docs/coupling.md): end B on a free body, an implicit scheme, no
+  // winch, contact or clamp at B, MuJoCo's Euler or implicit integrator. The tether then steps
+  // one MuJoCo step ahead with its end node B dynamic (this copy, Tether::WithDynamicEndB),
+  // carrying the body's effective mass, and the body gets the force consistent with that step.
+  std::optional<Tether> lead;
   // A winch (winch:NAME, docs/winch.md) at internal end A (sites swapped when declared at B).
   bool winch = false;
   bool swapped = false;            // the winch is at the declared end B
@@ -259,6 +265,132 @@ Mat3 SiteInverseMass(const mjModel* m, mjData* d, int s, double* jac) {
   return 0.5 * (W + W.transpose());
 }
 
+// Implicit steps accepted unconverged in an advance, counted with the time of the first.
+void CountStalls(const StepStatus& status, double time, double* u) {
+  if (status.stalled_steps > 0) {
+    if (u[kStalled] == 0) u[kStalledTime] = time;
+    u[kStalled] += status.stalled_steps;
+  }
+}
+
+// The consistent coupling is used from this coupling omega h on (docs/coupling.md): below it
+// the held force is accurate (BlueROV2 at EA 6e4, omega h 0.26: 0.65% in tension) and the
+// consistent one, which integrates the body-end mode with backward Euler, damps that mode
+// (2.3%). Only integrator=implicit: with bdf2 the body takes on the scheme's history (its
+// spurious root kept accelerating a body after a snap: 0.68 N s from nothing).
+constexpr double kLeadFrom = 1;
+
+// A tether with the consistent coupling at end B (AttachedTether::lead; docs/coupling.md).
+// At a callback at a new time t the tether is at t (stepped there at the last callback): end
+// node B is snapped to the site's actual position and velocity, and the tether steps ahead to
+// t + h with end node B dynamic, its mass the body's effective mass at the site W^-1 (W = J
+// M^-1 J^T, SiteInverseMass) plus its own, under the force W^-1 a_other, a_other the site's
+// acceleration without the tether at the last step (J qacc - W F, MuJoCo's qacc of the last
+// step is still in mjData at passive time; 0 at a restart). The body gets
+//   F = W^-1 ((v_B(t + h) - v_site(t))/h - a_other)
+// held over its step, which gives the site (MuJoCo's Euler: v+ = v + h M^-1 (f + J^T F)) the
+// velocity change end node B had, so the body carries the end's response within the step and
+// action and reaction match over it. A callback again at the time it stepped from (mj_forward
+// then mj_step at the same t) re-applies that force; a time that went back, a reset or a
+// teleported end restarts from the initial shape.
+void EvaluateLead(const mjModel* m, mjData* d, const AttachedTether& at, double* work,
+                  double* jac) {
+  double* u = d->userdata + at.offset;
+  if (u[kStatus] != 0) return;
+  const Tether& tether = *at.lead;
+  const int N = tether.segments(), n = tether.nodes();
+  Nodes x(u + kHeader, 3, n), v(u + kHeader + 3 * n, 3, n);
+  double* history = tether.HistorySize() > 0 ? u + kHeader + tether.StateSize() : nullptr;
+  double* c = u + kCoupleB;
+  double* cache = u + kForceA;
+  Ends now;
+  now.a = SiteState(m, d, at, 0, u);
+  now.b = SiteState(m, d, at, 1, u);
+  const bool restart = u[kInitialized] == 0 || d->time < u[kTime] ||
+                       Teleported(at, now, u, d->time);
+  // End A is on the world, a mocap body or a body without degrees of freedom: only end B's
+  // body moves under the tether.
+  auto apply = [&]() {
+    mj_applyFT(m, d, cache + 6, cache + 9, d->site_xpos + 3 * at.site[1], at.body[1],
+               d->qfrc_passive);
+  };
+  if (!restart && d->time == u[kTime]) return apply();  // the same step again
+  const double h = m->opt.timestep;
+  if (restart) {
+    tether.InitialShape(now, x.data(), v.data());
+    if (history) history[0] = 0;
+    u[kInitialized] = 1;
+    u[kStartTime] = d->time;
+    u[kStartStrain] = std::max(0.0, (now.b.pos - now.a.pos).norm() / tether.params().length - 1);
+    u[kTime] = u[kPrevTime] = d->time;
+    std::fill(u + kCoupleA, u + kCoupleA + kCoupleSize, 0.0);
+    std::fill(u + kCoupleB, u + kCoupleB + kCoupleSize, 0.0);
+    std::fill(cache, cache + 12, 0.0);
+    c[kLeadTime] = d->time;
+  } else {
+    u[kPrevTime] = u[kTime];
+    std::copy(u + kEndA, u + kEndA + 3, u + kPrevPosA);
+    std::copy(u + kEndB, u + kEndB + 3, u + kPrevPosB);
+    u[kTime] = d->time;
+  }
+  StoreEnd(now.a, u + kEndA);
+  StoreEnd(now.b, u + kEndB);
+  // The step to take: to t + h from the tether's time (t, unless a call was skipped).
+  const double dt = d->time + h - c[kLeadTime];
+  if (!(dt > 0)) return apply();
+  // End node B onto the site (its mismatch is O(h^2), from a_other's lag); bdf2's history of
+  // it follows, so that its last change ends at the snapped state.
+  const Vec3 dx = now.b.pos - Vec3(x.col(N)), dv = now.b.vel - Vec3(v.col(N));
+  x.col(N) = now.b.pos;
+  v.col(N) = now.b.vel;
+  if (history && history[0] > 0) {
+    Nodes xd(history + 1, 3, n), vd(history + 1 + 3 * n, 3, n);
+    xd.col(N) += dx;
+    vd.col(N) += dv;
+  }
+  const Mat3 W = SiteInverseMass(m, d, at.site[1], jac);  // jac: J (3 x nv) first
+  EndInertia body;
+  body.mass = W.inverse();
+  Vec3 a_other = Vec3::Zero();
+  if (!restart) {
+    for (int i = 0; i < 3; ++i) a_other[i] = mju_dot(jac + i * m->nv, d->qacc, m->nv);
+    a_other -= W * Vec3(cache + 6);
+  }
+  body.force = body.mass * a_other;
+  Ends from = now, to = now;
+  to.a.pos += dt * now.a.vel;
+  to.b.pos += dt * now.b.vel;
+  from.body_b = to.body_b = &body;
+  const StepStatus status = tether.Advance(x.data(), v.data(), from, to, dt, work, history);
+  c[kLeadTime] = d->time + h;
+  if (!status.ok) {
+    u[kStatus] = status.reason.rfind("strain", 0) == 0    ? kStrain
+                 : status.reason.rfind("kinetic", 0) == 0 ? kKinetic
+                                                          : kNonFinite;
+    u[kBadNode] = status.node;
+    u[kBadTime] = d->time;
+    return;
+  }
+  CountStalls(status, d->time, u);
+  // The force on the body from end node B's velocity change; the reactions at end A (and the
+  // torques) from the state at t + h with end B where its node is.
+  const Vec3 F = body.mass * ((Vec3(v.col(N)) - now.b.vel) / dt - a_other);
+  Ends after = to;
+  after.b.pos = x.col(N);
+  after.b.vel = v.col(N);
+  after.body_b = nullptr;
+  EndReactions r = tether.Reactions(x.data(), v.data(), after, work);
+  for (int i = 0; i < 3; ++i) {
+    cache[i] = r.force_a[i];
+    cache[3 + i] = r.torque_a[i];
+    cache[6 + i] = F[i];
+    cache[9 + i] = 0;
+  }
+  u[kTensionA] = r.tension_a;
+  u[kTensionB] = F.norm();
+  apply();
+}
+
 // One tether at one callback: initialise or advance to d->time, then apply the reactions.
 void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* work, double* jac) {
   double* u = d->userdata + at.offset;
@@ -384,10 +516,7 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
       }
       u[kContactCount] = stored;
     }
-    if (status.stalled_steps > 0) {
-      if (u[kStalled] == 0) u[kStalledTime] = d->time;
-      u[kStalled] += status.stalled_steps;
-    }
+    CountStalls(status, d->time, u);
     given[0] = status.work_a;
     given[1] = status.work_b;
     u[kPrevTime] = u[kTime];
@@ -636,7 +765,11 @@ void Passive(const mjModel* m, mjData* d) {
   double* work = mj_stackAlloc(d, set->work_size);
   double* jac = mj_stackAlloc(d, 6 * std::max(set->nv, 1));
   for (const AttachedTether& at : set->tethers) {
-    Evaluate(m, d, at, work, jac);
+    if (at.lead) {
+      EvaluateLead(m, d, at, work, jac);
+    } else {
+      Evaluate(m, d, at, work, jac);
+    }
     CheckEndDamping(m, d, at, work, jac);
   }
   mjFREESTACK;
@@ -1067,6 +1200,12 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
                 : p.integrator == Integrator::kExplicit  ? kCouplingLimitExplicit
                 : p.integrator == Integrator::kImplicit2 ? kCouplingLimitImplicit2
                                                          : 0;
+      // The consistent coupling (EvaluateLead) where the held force is not resolved.
+      if (end == 1 && c.omega_h >= kLeadFrom && p.integrator == Integrator::kImplicit &&
+          !at.coupled[0] && !at.winch && !at.contact && !p.clamp_b &&
+          FreeCarrier(m, at.body[1]) > 0 && m->opt.integrator != mjINT_RK4) {
+        at.lead = t.WithDynamicEndB();
+      }
       c.applies = c.limit > 0;
       if (!c.applies) continue;
       const char* body = mj_id2name(m, mjOBJ_BODY, c.body);
@@ -1456,6 +1595,7 @@ const double* NodeVelocities(const mjModel* m, const mjData* d, int k) {
 
 double TetherTime(const mjModel* m, const mjData* d, int k) {
   const double* u = UserBlock(m, d, k);
+  if (u && Lookup(m)->tethers[k].lead) return u[kCoupleB + kLeadTime];  // one step ahead
   return u ? u[kTime] : 0;
 }
 

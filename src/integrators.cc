@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Eigenvalues>
+
 #include "detail/work.h"
 
 namespace mjtether {
@@ -30,7 +32,7 @@ EndState Interpolate(const EndState& e0, const EndState& e1, double dt, double s
 Ends Interpolate(const Ends& from, const Ends& to, double dt, double s) {
   return {Interpolate(from.a, to.a, dt, s), Interpolate(from.b, to.b, dt, s),
           from.time + s * (to.time - from.time), to.contacts,
-          from.rest + s * (to.rest - from.rest)};
+          from.rest + s * (to.rest - from.rest), to.body_b};
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -40,7 +42,7 @@ Ends Interpolate(const Ends& from, const Ends& to, double dt, double s) {
 void Tether::PlaceEnds(const Ends& e, Nodes x, Nodes v) const {
   x.col(0) = e.a.pos;
   v.col(0) = e.a.vel;
-  if (!p_.free_end) {
+  if (!DynamicB()) {
     x.col(N_) = e.b.pos;
     v.col(N_) = e.b.vel;
   }
@@ -159,16 +161,18 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   (void)now;
   Work w(work, N_);
   const int n = N_ + 1;
-  const int nu = N_ - 1 + (p_.free_end ? 1 : 0);  // dynamic nodes 1..nu, unknown u = i - 1
+  const int nu = N_ - 1 + (DynamicB() ? 1 : 0);  // dynamic nodes 1..nu, unknown u = i - 1
+  // A body at end B (consistent coupling): its effective mass and force join end node B's.
+  const EndInertia* body = dynamic_b_ ? next.body_b : nullptr;
   Nodes xk(w.x2, 3, n), vk(w.v2, 3, n);
   // Initial iterate: velocities unchanged, ends at the end of the step.
   vk = v;
   vk.col(0) = next.a.vel;
-  if (!p_.free_end) vk.col(N_) = next.b.vel;
+  if (!DynamicB()) vk.col(N_) = next.b.vel;
   auto place = [&]() {
     xk = x + h * vk;
     xk.col(0) = next.a.pos;
-    if (!p_.free_end) xk.col(N_) = next.b.pos;
+    if (!DynamicB()) xk.col(N_) = next.b.pos;
   };
   place();
   if (nu == 0) {
@@ -183,6 +187,11 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   const double h2 = h * h;
   const bool added = Has(kAddedMass);
   Start start{ConstNodes(x.data(), 3, n), h, false};
+  const double body_min_mass =
+      body ? Eigen::SelfAdjointEigenSolver<Mat3>(body->mass, Eigen::EigenvaluesOnly)
+                 .eigenvalues()
+                 .minCoeff()
+           : 0;  // [kg]
 
   // Forces at the iterate, and the residual -G = h f - M (v+ - v) (node mass with normal added
   // mass) into rhs. Returns phi*2 and, in *err, the largest |G_i|/m_i [m/s].
@@ -197,10 +206,17 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         const Vec3 qi = q.col(i);
         r -= Added(i) * (dvi - qi.dot(dvi) * qi);
       }
+      double inv = InvMass(i);
+      if (body && i == N_) {
+        // The body's share: (W^-1 + m) dv = h (f + W^-1 a_other); G weighted by the inverse
+        // of the smallest total mass along a direction.
+        r += h * body->force - body->mass * dvi;
+        inv = 1 / (Mass(i) + body_min_mass);
+      }
       rhs.col(i - 1) = r;
       const double r2 = r.squaredNorm();
-      phi += r2 * InvMass(i);
-      worst = std::max(worst, r2 * InvMass(i) * InvMass(i));
+      phi += r2 * inv;
+      worst = std::max(worst, r2 * inv * inv);
     }
     *err = std::sqrt(worst);
     return phi;
@@ -220,6 +236,7 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
       } else {
         d = Mass(i) * I;
       }
+      if (body && i == N_) d += body->mass;
     }
     // Axial stiffness and damping of taut segments: B = h D + h^2 K with
     // K = EA/L0 t t^T + T/l (I - t t^T), D = damping/L0 t t^T; +B on both diagonal blocks,
@@ -746,7 +763,7 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
     // start of the step; implicit: the last Newton iterate; rk4: the last stage).
     const ConstNodes f(Work(work, N_).f, 3, n);
     status.work_a += f.col(0).dot(next.a.pos - now.a.pos);
-    if (!p_.free_end) status.work_b += f.col(N_).dot(next.b.pos - now.b.pos);
+    if (!DynamicB()) status.work_b += f.col(N_).dot(next.b.pos - now.b.pos);
     now = next;
   }
   Check(ConstNodes(xp, 3, n), ConstNodes(vp, 3, n), from, to, &status);

@@ -39,6 +39,15 @@ struct EndState {
   Vec3 axis = Vec3::UnitX();  // [-] site x-axis (clamp direction, pointing into the tether)
 };
 
+// A body at end B whose inverse mass at the site is W [1/kg] (docs/coupling.md, consistent
+// coupling): with it, a tether made by Tether::WithDynamicEndB() steps its end node B as a
+// dynamic node carrying the body's effective mass W^-1 besides its own, under the force
+// W^-1 a_other that gives the site the acceleration a_other it has without the tether.
+struct EndInertia {
+  Eigen::Matrix3d mass = Eigen::Matrix3d::Zero();  // [kg] W^-1
+  Vec3 force = Vec3::Zero();                       // [N] W^-1 a_other
+};
+
 struct Ends {
   EndState a;
   EndState b;  // unused when end B is free
@@ -49,6 +58,8 @@ struct Ends {
   // With a winch (a view from Tether::Deployed): the rest length of the winch segment (segment
   // 0, from the drum at end A) at this instant [m]; 0 without a winch.
   double rest = 0;
+  // A body at end B (a tether from WithDynamicEndB(); null otherwise): see EndInertia.
+  const EndInertia* body_b = nullptr;
 };
 
 // The deployment of a tether with a winch at end A (docs/winch.md). Nodes 0..first-1 are on
@@ -93,6 +104,16 @@ class Tether {
   // sets *error) if the parameters are inconsistent (they are range-checked by the parser).
   static std::optional<Tether> Create(const TetherParams& params, const Environment& env,
                                       std::string* error);
+  // The same tether with its end node B stepped as a dynamic node (the consistent coupling,
+  // docs/coupling.md): Advance places only end A, and end node B moves under its forces plus
+  // Ends::body_b's (its mass and force added to the node's). Implicit schemes only (implicit,
+  // implicit2, bdf2); params().free_end stays false, so InitialShape and Reactions are the
+  // attached tether's.
+  Tether WithDynamicEndB() const {
+    Tether t = *this;
+    t.dynamic_b_ = true;
+    return t;
+  }
 
   const TetherParams& params() const { return p_; }
   const Environment& env() const { return env_; }
@@ -269,10 +290,13 @@ class Tether {
                     double* work, StepStatus* stats, const History& history) const;
 
   bool Has(unsigned effect) const { return (p_.effects & effect) != 0; }
-  bool Dynamic(int i) const { return i > 0 && (i < N_ || p_.free_end); }
+  bool Dynamic(int i) const { return i > 0 && (i < N_ || p_.free_end || dynamic_b_); }
+  // End node B is stepped (free, or a body's end in a WithDynamicEndB() tether).
+  bool DynamicB() const { return p_.free_end || dynamic_b_; }
 
   TetherParams p_;
   Environment env_;
+  bool dynamic_b_ = false;  // see WithDynamicEndB
   int N_ = 0;
   double L0_ = 0;               // [m] rest length of a segment
   double area_ = 0;             // [m^2] pi d^2 / 4
