@@ -50,8 +50,8 @@ enum Slot : int {
   kStalled,                         // implicit steps accepted unconverged since the start
   kStalledTime,                     // [s] d->time of the call that first reported one
   kCoupleA,                         // end A on a body that moves: see CoupleSlot
-  kCoupleB = kCoupleA + 5,
-  kHeader = kCoupleB + 5,  // x (3 x n) then v (3 x n) follow, then the integrator's history
+  kCoupleB = kCoupleA + 6,  // (6 = kCoupleSize, below)
+  kHeader = kCoupleB + 6,  // x (3 x n) then v (3 x n) follow, then the integrator's history
                            // (Tether::HistorySize, bdf2), then with contact `capacity` records
 };
 // A contact reaction record: body, force on it [N] (3), point of application [m] (3), applied
@@ -72,6 +72,8 @@ enum CoupleSlot : int {
   kLeadTime = 5,     // [s] end B of a lead tether: the time its state is at (see EvaluateLead)
   kCoupleSize = 6,
 };
+static_assert(kCoupleB - kCoupleA == kCoupleSize && kHeader - kCoupleB == kCoupleSize,
+              "the header's coupling blocks hold kCoupleSize slots each");
 
 // Divergence codes in kStatus.
 enum Divergence : int {
