@@ -10,44 +10,6 @@ namespace mjtether {
 using namespace detail;
 namespace {
 
-// Places nodes first..last (columns of x) along the polyline p[0..np-1], starting from the
-// point x.col(first - 1) at arc position 0 on the polyline, each node at chord distance L0
-// from the one before it: the first point along the path at that distance. Spacing nodes by
-// arc length instead cuts every corner of the path, so a node next to a corner sits closer
-// than L0 to its neighbour (a 90-degree corner half a segment from a node: 0.71 L0), which a
-// tether with compression stiffness EAc starts compressed (an anchor 5 cm above the seabed
-// with 0.2 m segments: 0.79 L0, 10 kN at EAc 5e4). Returns the arc length of path that node
-// `last` lies short of the polyline's end (negative: it needed that much more path than there
-// is; it is then placed at the end).
-double ChordWalk(const Vec3* p, int np, double L0, Nodes x, int first, int last) {
-  int j = 0;       // current polyline piece [p[j], p[j+1]]
-  Vec3 at = p[0];  // current point on it
-  for (int k = first; k <= last; ++k) {
-    const Vec3 c = x.col(k - 1);
-    bool found = false;
-    for (; j + 1 < np; ++j) {
-      const Vec3 e = p[j + 1] - at;
-      const double len2 = e.squaredNorm();
-      if ((p[j + 1] - c).norm() < L0 || len2 == 0) {
-        at = p[j + 1];
-        continue;
-      }
-      // |at + t e - c| = L0 for the larger root t in [0, 1] (at is within L0 of c).
-      const Vec3 f = at - c;
-      const double b = f.dot(e), cc = f.squaredNorm() - L0 * L0;
-      const double t = (-b + std::sqrt(std::max(0.0, b * b - len2 * cc))) / len2;
-      at += std::clamp(t, 0.0, 1.0) * e;
-      found = true;
-      break;
-    }
-    x.col(k) = at;
-    if (!found) return -(L0 - (at - c).norm()) - (last - k) * L0;
-  }
-  double rest = (p[j + 1 < np ? j + 1 : np - 1] - at).norm();
-  for (int i = j + 1; i + 1 < np; ++i) rest += (p[i + 1] - p[i]).norm();
-  return rest;
-}
-
 // Largest stable step of classical RK4 [s] for the modes of a chain whose highest frequency is
 // w [rad/s] with damping ratio zeta. Internal damping is stiffness-proportional, so a mode of
 // frequency s w has ratio s zeta and eigenvalues s w (-s zeta +- i sqrt(1 - s^2 zeta^2)) (real
@@ -415,13 +377,12 @@ void Tether::RestOnLevel(const Ends& ends, double zb, Nodes x) const {
     return;
   }
   const Vec3 A0(A.x(), A.y(), zb);  // end A projected on the seabed
-  const double L0 = L / N_;
   if (p_.free_end) {
-    // Straight down, then along the site's axis; nodes a chord L0 apart (ChordWalk).
     const Vec3 eh = horizontal(ends.a.axis);
-    const Vec3 path[3] = {A, A0, A0 + 2 * L * eh};
-    x.col(0) = A;
-    ChordWalk(path, 3, L0, x, 1, N_);
+    for (int k = 0; k <= N_; ++k) {
+      const double s = L * k / N_;
+      x.col(k) = s <= hA ? Vec3(A - s * ez) : Vec3(A0 + (s - hA) * eh);
+    }
     return;
   }
   const Vec3& B = ends.b.pos;
@@ -435,73 +396,42 @@ void Tether::RestOnLevel(const Ends& ends, double zb, Nodes x) const {
     *s = std::sqrt(h * h + 2 * a * h);
     *xh = a > 0 ? a * std::acosh(1 + h / a) : 0;
   };
-  // The path: the hanging part from A to its touchdown point (a catenary of parameter a,
-  // sampled at kHang points; a = 0: straight down), the grounded part (a sideways U out by d
-  // when there is length over), the hanging part up to B. The nodes go a chord L0 apart along
-  // it (ChordWalk): spaced by arc length they would cut its corners (the touchdown of a small
-  // a, the U's corners) and start compressed. What the chords cut off is made up by solving,
-  // instead of sA + sB + H - xA - xB = L, for the a (or, where even a = 0 leaves length over,
-  // the d) at which node N lands on B: the path beyond node N falls monotonically as a grows
-  // (the path shortens) and as d falls, and the corners' cut varies far less. Bisection.
-  constexpr int kHang = 48;
-  Vec3 path[2 * kHang + 6];
-  auto walk = [&](double a, double d) {
-    double sA, sB, xA, xB;
+  double a = 0, sA = hA, sB = hB, xA = 0, xB = 0, detour = 0;
+  if (L >= hA + hB + H) {
+    detour = 0.5 * (L - hA - hB - H);
+  } else {
+    double lo = std::log(1e-12 * L), hi = std::log(1e12 * L);
+    for (int it = 0; it < 200; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      hang(std::exp(mid), hA, &sA, &xA);
+      hang(std::exp(mid), hB, &sB, &xB);
+      (sA + sB + H - xA - xB > L ? lo : hi) = mid;
+    }
+    a = std::exp(0.5 * (lo + hi));
     hang(a, hA, &sA, &xA);
     hang(a, hB, &sB, &xB);
-    const Vec3 TA = A0 + xA * eh, TB = B0 - xB * eh;  // touchdown points
-    // A point of a hanging part at arc length sigma from its touchdown point T, along dir.
-    auto hanging = [&](const Vec3& T, const Vec3& dir, double sigma) -> Vec3 {
-      const double u = a > 0 ? a * std::asinh(sigma / a) : 0;
-      return T + u * dir + (std::sqrt(a * a + sigma * sigma) - a) * ez;
-    };
-    int n = 0;
-    for (int i = 0; i <= kHang; ++i) path[n++] = hanging(TA, -eh, sA * (kHang - i) / kHang);
-    const double run = std::max(0.0, H - xA - xB);
-    if (d > 0) {
-      path[n++] = TA + d * en;
-      path[n++] = TA + d * en + run * eh;
-    }
-    for (int i = 0; i <= kHang; ++i) path[n++] = hanging(TB, eh, sB * i / kHang);
-    path[0] = A;
-    path[n - 1] = B;
-    x.col(0) = A;
-    return ChordWalk(path, n, L0, x, 1, N_);
-  };
-  double a = 0, d = 0;
-  if (walk(0, 0) < 0) {
-    // Length over at a = 0: the U, from no detour up.
-    double lo = 0, hi = std::max(0.0, 0.5 * (L - hA - hB - H)) + 2 * L0;
-    for (int it = 0; it < 100 && walk(0, hi) < 0; ++it) hi += 2 * L0;
-    for (int it = 0; it < 60; ++it) {
-      const double mid = 0.5 * (lo + hi);
-      (walk(0, mid) < 0 ? lo : hi) = mid;
-    }
-    d = hi;
-  } else {
-    // a up to where the two touchdown points meet (xA + xB = H, a catenary touching the
-    // seabed at one point; beyond it the hanging parts would pass each other).
-    auto reach = [&](double a) {
-      double s, xa, xb;
-      hang(a, hA, &s, &xa);
-      hang(a, hB, &s, &xb);
-      return xa + xb;
-    };
-    double lo = std::log(1e-12 * L), hi = std::log(1e12 * L);
-    for (int it = 0; it < 100; ++it) {
-      const double mid = 0.5 * (lo + hi);
-      (reach(std::exp(mid)) < H ? lo : hi) = mid;
-    }
-    hi = lo;
-    lo = std::log(1e-12 * L);
-    for (int it = 0; it < 100; ++it) {
-      const double mid = 0.5 * (lo + hi);
-      (walk(std::exp(mid), 0) > 0 ? lo : hi) = mid;
-    }
-    a = std::exp(lo);
   }
-  walk(a, d);
-  for (int k = 1; k < N_; ++k) x(2, k) = std::max(x(2, k), zb);  // round-off
+  const double run = std::max(0.0, H - xA - xB);  // grounded length along eh
+  const Vec3 TA = A0 + xA * eh, TB = B0 - xB * eh;  // touchdown points
+  // A point of a hanging part at arc length sigma from its touchdown point T, going along dir.
+  auto hanging = [&](const Vec3& T, const Vec3& dir, double sigma) -> Vec3 {
+    const double u = a > 0 ? a * std::asinh(sigma / a) : 0;
+    return T + u * dir + (std::sqrt(a * a + sigma * sigma) - a) * ez;
+  };
+  for (int k = 1; k < N_; ++k) {
+    const double s = L * k / N_;
+    if (s <= sA) {
+      x.col(k) = hanging(TA, -eh, sA - s);
+    } else if (s >= L - sB) {
+      x.col(k) = hanging(TB, eh, s - (L - sB));
+    } else {
+      const double r = s - sA;  // along the grounded part: out by `detour`, along, back
+      x.col(k) = r < detour         ? Vec3(TA + r * en)
+                 : r < detour + run ? Vec3(TA + detour * en + (r - detour) * eh)
+                                    : Vec3(TA + (2 * detour + run - r) * en + run * eh);
+    }
+    x(2, k) = std::max(x(2, k), zb);  // round-off
+  }
   x.col(0) = A;
   x.col(N_) = B;
 }
