@@ -11,22 +11,12 @@
 
 #include "make_tether.h"
 #include "tether.h"
+#include "slack_scene.h"
 
 namespace mjtether {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
-// End B circles in the y-z plane 5 m from end A (radius 1 m, period 4 s), so that a 7.6 m
-// tether between them is always slack (the scene of tests/bench/bench_slack.cc).
-Ends Circling(double t) {
-  const double w = 2 * kPi / 4, r = 1;
-  Ends e;
-  e.a.pos = Vec3(0, 0, 0);
-  e.b.pos = Vec3(5, r * std::sin(w * t), r * (std::cos(w * t) - 1));
-  e.b.vel = Vec3(0, r * w * std::cos(w * t), -r * w * std::sin(w * t));
-  return e;
-}
 
 // 152 segments of 5 cm, dry, no gravity, damping 200 N s (damping time m L0/damping = 4 us
 // against the 2 ms step): segments hover at L0 and many change between slack and taut in every

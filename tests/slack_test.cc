@@ -10,6 +10,7 @@
 
 #include "make_tether.h"
 #include "tether.h"
+#include "slack_scene.h"
 
 namespace mjtether {
 namespace {
@@ -17,16 +18,6 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kG = 9.81;
 
-// End B circles in the y-z plane 5 m from end A (radius 1 m, period 4 s), so that a 7.6 m
-// tether between them is always slack (the scene of tests/bench/bench_slack.cc).
-Ends Circling(double t) {
-  const double w = 2 * kPi / 4, r = 1;
-  Ends e;
-  e.a.pos = Vec3(0, 0, 0);
-  e.b.pos = Vec3(5, r * std::sin(w * t), r * (std::cos(w * t) - 1));
-  e.b.vel = Vec3(0, r * w * std::cos(w * t), -r * w * std::sin(w * t));
-  return e;
-}
 
 // A tether with 23 of its 30 m laid out on a seabed at z = -10 (one period of a sine across x;
 // friction 0.3), ends at (0, 0, -4) and (20, 0, -9.5), settles with the implicit step at 2 ms

@@ -8,9 +8,9 @@ MuJoCo's grey 0..255 -> 0..elevation (the hfield's size[2]) is the whole scale.
 Usage: python3 tools/make_rock_png.py [OUT.png]   (only python3 and zlib)
 """
 import math
-import struct
 import sys
-import zlib
+
+from make_seabed_png import png  # the same 8-bit grey PNG writer
 
 N = 61
 
@@ -25,16 +25,6 @@ def height(i, j):
     bumps = 0.06 * (math.sin(2 * math.pi * (1.5 * x + 0.1)) * math.cos(2 * math.pi * 1.2 * y)
                     + 0.5 * math.sin(2 * math.pi * (2.5 * x - 1.7 * y)))
     return max(0.0, dome * (1 + bumps))
-
-
-def png(width, height_, rows):
-    def chunk(kind, data):
-        c = struct.pack(">I", len(data)) + kind + data
-        return c + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
-    raw = b"".join(b"\x00" + bytes(r) for r in rows)  # filter 0 on every row
-    return (b"\x89PNG\r\n\x1a\n"
-            + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height_, 8, 0, 0, 0, 0))
-            + chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b""))
 
 
 def main():

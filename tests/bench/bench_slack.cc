@@ -30,6 +30,7 @@
 
 #include "declaration.h"
 #include "tether.h"
+#include "../slack_scene.h"
 
 namespace mjtether {
 namespace {
@@ -180,16 +181,6 @@ void Settle(benchmark::State& state, bool seabed) {
       seabed ? kSeabed : NAN);
 }
 
-// End B circles in the y-z plane 5 m from end A (radius 1 m, period 4 s), from rest at t = 0
-// with the circle's velocity.
-Ends Circling(double t) {
-  const double w = 2 * kPi / 4, r = 1;
-  Ends e;
-  e.a.pos = Vec3(0, 0, 0);
-  e.b.pos = Vec3(5, r * std::sin(w * t), r * (std::cos(w * t) - 1));
-  e.b.vel = Vec3(0, r * w * std::cos(w * t), -r * w * std::sin(w * t));
-  return e;
-}
 
 void Slack(benchmark::State& state, bool wet, double damping) {
   const std::string tether =
