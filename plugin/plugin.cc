@@ -235,6 +235,28 @@ EndState LoadEnd(const double* src) {
   return e;
 }
 
+// The header's bookkeeping of a (re)start from the initial shape at `time`, the ends at `now`
+// (start_strain: the chord's strain then, 0 when not stretched).
+void RecordStart(double* u, const Ends& now, double time, double start_strain) {
+  u[kInitialized] = 1;
+  u[kStartTime] = time;
+  u[kStartStrain] = start_strain;
+  u[kTime] = u[kPrevTime] = time;
+  StoreEnd(now.a, u + kEndA);
+  StoreEnd(now.b, u + kEndB);
+}
+
+// The header's bookkeeping of an advance to `time`, the ends at `now`: the last time and end
+// positions become the previous ones (mocap velocity, second order).
+void RecordAdvance(double* u, const Ends& now, double time) {
+  u[kPrevTime] = u[kTime];
+  std::copy(u + kEndA, u + kEndA + 3, u + kPrevPosA);
+  std::copy(u + kEndB, u + kEndB + 3, u + kPrevPosB);
+  u[kTime] = time;
+  StoreEnd(now.a, u + kEndA);
+  StoreEnd(now.b, u + kEndB);
+}
+
 // An end teleported by the user (qpos or mocap_pos set by hand): since the last call it moved
 // farther than its velocity then explains, by more than max_strain segment lengths. No tether
 // can follow that within max_strain, so the tether restarts from its initial shape instead of
@@ -321,22 +343,15 @@ void EvaluateLead(const mjModel* m, mjData* d, const AttachedTether& at, double*
   if (restart) {
     tether.InitialShape(now, x.data(), v.data());
     if (history) history[0] = 0;
-    u[kInitialized] = 1;
-    u[kStartTime] = d->time;
-    u[kStartStrain] = std::max(0.0, (now.b.pos - now.a.pos).norm() / tether.params().length - 1);
-    u[kTime] = u[kPrevTime] = d->time;
+    RecordStart(u, now, d->time,
+                std::max(0.0, (now.b.pos - now.a.pos).norm() / tether.params().length - 1));
     std::fill(u + kCoupleA, u + kCoupleA + kCoupleSize, 0.0);
     std::fill(u + kCoupleB, u + kCoupleB + kCoupleSize, 0.0);
     std::fill(cache, cache + 12, 0.0);
     c[kLeadTime] = d->time;
   } else {
-    u[kPrevTime] = u[kTime];
-    std::copy(u + kEndA, u + kEndA + 3, u + kPrevPosA);
-    std::copy(u + kEndB, u + kEndB + 3, u + kPrevPosB);
-    u[kTime] = d->time;
+    RecordAdvance(u, now, d->time);
   }
-  StoreEnd(now.a, u + kEndA);
-  StoreEnd(now.b, u + kEndB);
   // The step to take: to t + h from the tether's time (t, unless a call was skipped).
   const double dt = d->time + h - c[kLeadTime];
   if (!(dt > 0)) return apply();
@@ -440,14 +455,8 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
     }
     // bdf2 starts again with a backward-Euler step (no history yet).
     if (history) history[0] = 0;
-    u[kInitialized] = 1;
-    u[kStartTime] = d->time;
-    u[kStartStrain] =
-        free_end ? 0
-                 : std::max(0.0, (now.b.pos - now.a.pos).norm() / DeployedLength(at, u) - 1);
-    u[kTime] = u[kPrevTime] = d->time;
-    StoreEnd(now.a, u + kEndA);
-    StoreEnd(now.b, u + kEndB);
+    const double chord = free_end ? 0 : (now.b.pos - now.a.pos).norm();
+    RecordStart(u, now, d->time, std::max(0.0, chord / DeployedLength(at, u) - 1));
   } else if (d->time > u[kTime]) {
     Ends from{LoadEnd(u + kEndA), LoadEnd(u + kEndB)};
     const double dt = d->time - u[kTime];
@@ -521,12 +530,7 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
     CountStalls(status, d->time, u);
     given[0] = status.work_a;
     given[1] = status.work_b;
-    u[kPrevTime] = u[kTime];
-    std::copy(u + kEndA, u + kEndA + 3, u + kPrevPosA);
-    std::copy(u + kEndB, u + kEndB + 3, u + kPrevPosB);
-    u[kTime] = d->time;
-    StoreEnd(now.a, u + kEndA);
-    StoreEnd(now.b, u + kEndB);
+    RecordAdvance(u, now, d->time);
     advanced = true;
   }
 
