@@ -257,6 +257,16 @@ void RecordAdvance(double* u, const Ends& now, double time) {
   StoreEnd(now.b, u + kEndB);
 }
 
+// A failed step: the divergence code from its reason, the node and the time, in the header
+// (the tether then stays inert until a reset).
+void RecordFailure(double* u, const StepStatus& status, double time) {
+  u[kStatus] = status.reason.rfind("strain", 0) == 0    ? kStrain
+               : status.reason.rfind("kinetic", 0) == 0 ? kKinetic
+                                                        : kNonFinite;
+  u[kBadNode] = status.node;
+  u[kBadTime] = time;
+}
+
 // An end teleported by the user (qpos or mocap_pos set by hand): since the last call it moved
 // farther than its velocity then explains, by more than max_strain segment lengths. No tether
 // can follow that within max_strain, so the tether restarts from its initial shape instead of
@@ -380,14 +390,7 @@ void EvaluateLead(const mjModel* m, mjData* d, const AttachedTether& at, double*
   from.body_b = to.body_b = &body;
   const StepStatus status = tether.Advance(x.data(), v.data(), from, to, dt, work, history);
   c[kLeadTime] = d->time + h;
-  if (!status.ok) {
-    u[kStatus] = status.reason.rfind("strain", 0) == 0    ? kStrain
-                 : status.reason.rfind("kinetic", 0) == 0 ? kKinetic
-                                                          : kNonFinite;
-    u[kBadNode] = status.node;
-    u[kBadTime] = d->time;
-    return;
-  }
+  if (!status.ok) return RecordFailure(u, status, d->time);
   CountStalls(status, d->time, u);
   // The force on the body from end node B's velocity change; the reactions at end A (and the
   // torques) from the state at t + h with end B where its node is.
@@ -492,14 +495,7 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
     } else {
       status = tether.Advance(x, v, from, now, dt, work, history);
     }
-    if (!status.ok) {
-      u[kStatus] = status.reason.rfind("strain", 0) == 0    ? kStrain
-                   : status.reason.rfind("kinetic", 0) == 0 ? kKinetic
-                                                            : kNonFinite;
-      u[kBadNode] = status.node;
-      u[kBadTime] = d->time;
-      return;
-    }
+    if (!status.ok) return RecordFailure(u, status, d->time);
     // Each body gets the opposite of the impulse its geoms gave the tether, spread over the
     // next step as a constant force at the contact point.
     if (at.contact) {
