@@ -2,4 +2,4 @@
 # a slope, declaration errors.
 add_executable(contact_test contact_test.cc)
 target_link_libraries(contact_test PRIVATE mjtether_plugin GTest::gtest_main)
-gtest_discover_tests(contact_test DISCOVERY_TIMEOUT 60 PROPERTIES LABELS contact)
+gtest_discover_tests(contact_test NO_PRETTY_VALUES DISCOVERY_TIMEOUT 60 PROPERTIES LABELS contact)

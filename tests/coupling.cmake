@@ -5,4 +5,4 @@ target_compile_definitions(coupling_test PRIVATE
   MJTETHER_MODELS_DIR="${PROJECT_SOURCE_DIR}/models"
   MJTETHER_CLI="$<TARGET_FILE:mjtether>")
 add_dependencies(coupling_test mjtether)
-gtest_discover_tests(coupling_test DISCOVERY_TIMEOUT 60)
+gtest_discover_tests(coupling_test NO_PRETTY_VALUES DISCOVERY_TIMEOUT 60)

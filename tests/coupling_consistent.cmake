@@ -4,4 +4,4 @@ add_executable(coupling_consistent_test coupling_consistent_test.cc)
 target_link_libraries(coupling_consistent_test PRIVATE mjtether_plugin GTest::gtest_main)
 target_compile_definitions(coupling_consistent_test PRIVATE
   MJTETHER_MODELS_DIR="${PROJECT_SOURCE_DIR}/models")
-gtest_discover_tests(coupling_consistent_test DISCOVERY_TIMEOUT 60)
+gtest_discover_tests(coupling_consistent_test NO_PRETTY_VALUES DISCOVERY_TIMEOUT 60)

@@ -7,4 +7,4 @@ target_compile_definitions(gallery_framing_test PRIVATE
   MJTETHER_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 # Label "gallery": minutes of simulation (the workclass run is 300 s simulated, twice); the
 # sanitizer run of .ci/run leaves it out (the pose code is under ASan in render_framing_test).
-gtest_discover_tests(gallery_framing_test DISCOVERY_TIMEOUT 60 PROPERTIES LABELS gallery)
+gtest_discover_tests(gallery_framing_test NO_PRETTY_VALUES DISCOVERY_TIMEOUT 60 PROPERTIES LABELS gallery)

@@ -4,4 +4,4 @@ add_executable(hfield_rock_test hfield_rock_test.cc)
 target_link_libraries(hfield_rock_test PRIVATE mjtether_plugin GTest::gtest_main)
 target_compile_definitions(hfield_rock_test PRIVATE
   MJTETHER_MODELS_DIR="${PROJECT_SOURCE_DIR}/models")
-gtest_discover_tests(hfield_rock_test DISCOVERY_TIMEOUT 60 PROPERTIES LABELS contact)
+gtest_discover_tests(hfield_rock_test NO_PRETTY_VALUES DISCOVERY_TIMEOUT 60 PROPERTIES LABELS contact)

@@ -6,7 +6,7 @@ target_compile_definitions(hostile_test PRIVATE
   MJTETHER_HOSTILE_DIR="${CMAKE_CURRENT_SOURCE_DIR}/hostile"
   MJTETHER_CLI="$<TARGET_FILE:mjtether>")
 add_dependencies(hostile_test mjtether)
-gtest_discover_tests(hostile_test DISCOVERY_TIMEOUT 60 PROPERTIES LABELS hostile)
+gtest_discover_tests(hostile_test NO_PRETTY_VALUES DISCOVERY_TIMEOUT 60 PROPERTIES LABELS hostile)
 
 add_executable(observe_test observe_test.cc)
 target_link_libraries(observe_test PRIVATE mjtether_plugin GTest::gtest_main)
@@ -15,4 +15,4 @@ target_compile_definitions(observe_test PRIVATE
   MJTETHER_HOSTILE_DIR="${CMAKE_CURRENT_SOURCE_DIR}/hostile"
   MJTETHER_CLI="$<TARGET_FILE:mjtether>")
 add_dependencies(observe_test mjtether)
-gtest_discover_tests(observe_test DISCOVERY_TIMEOUT 60)
+gtest_discover_tests(observe_test NO_PRETTY_VALUES DISCOVERY_TIMEOUT 60)

@@ -3,4 +3,4 @@
 # tools/accuracy_cost.sh (tests/bench/accuracy_cost.cc), not part of CTest.
 add_executable(perf_test perf_test.cc)
 target_link_libraries(perf_test PRIVATE mjtether_core GTest::gtest_main)
-gtest_discover_tests(perf_test DISCOVERY_TIMEOUT 60 PROPERTIES LABELS perf)
+gtest_discover_tests(perf_test NO_PRETTY_VALUES DISCOVERY_TIMEOUT 60 PROPERTIES LABELS perf)

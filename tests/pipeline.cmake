@@ -6,4 +6,4 @@ target_compile_definitions(pipeline_test PRIVATE
   MJTETHER_MODELS_DIR="${PROJECT_SOURCE_DIR}/models"
   MJTETHER_CLI="$<TARGET_FILE:mjtether>")
 add_dependencies(pipeline_test mjtether)
-gtest_discover_tests(pipeline_test DISCOVERY_TIMEOUT 60)
+gtest_discover_tests(pipeline_test NO_PRETTY_VALUES DISCOVERY_TIMEOUT 60)

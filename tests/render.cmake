@@ -6,7 +6,7 @@ target_compile_definitions(render_test PRIVATE
   MJTETHER_MODELS_DIR="${PROJECT_SOURCE_DIR}/models"
   MJTETHER_CLI="$<TARGET_FILE:mjtether>")
 add_dependencies(render_test mjtether)
-gtest_discover_tests(render_test DISCOVERY_TIMEOUT 60)
+gtest_discover_tests(render_test NO_PRETTY_VALUES DISCOVERY_TIMEOUT 60)
 
 # Framing and layout (issue 16): the vehicle seen in the shipped scenes, overlays off the tether,
 # smooth camera, overlays that fit at 320x240 and 1920x1080; the CLI's last instant, auto, plot.
@@ -16,4 +16,4 @@ target_compile_definitions(render_framing_test PRIVATE
   MJTETHER_MODELS_DIR="${PROJECT_SOURCE_DIR}/models"
   MJTETHER_CLI="$<TARGET_FILE:mjtether>")
 add_dependencies(render_framing_test mjtether)
-gtest_discover_tests(render_framing_test DISCOVERY_TIMEOUT 60)
+gtest_discover_tests(render_framing_test NO_PRETTY_VALUES DISCOVERY_TIMEOUT 60)

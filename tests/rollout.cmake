@@ -5,4 +5,4 @@ add_executable(rollout_test rollout_test.cc)
 target_link_libraries(rollout_test PRIVATE mjtether_plugin GTest::gtest_main Threads::Threads)
 target_compile_definitions(rollout_test PRIVATE
   MJTETHER_MODELS_DIR="${PROJECT_SOURCE_DIR}/models")
-gtest_discover_tests(rollout_test DISCOVERY_TIMEOUT 60)
+gtest_discover_tests(rollout_test NO_PRETTY_VALUES DISCOVERY_TIMEOUT 60)

@@ -10,7 +10,7 @@ target_compile_definitions(robust_test PRIVATE
   MJTETHER_MODELS_DIR="${PROJECT_SOURCE_DIR}/models"
   MJTETHER_CLI="$<TARGET_FILE:mjtether>")
 add_dependencies(robust_test mjtether)
-gtest_discover_tests(robust_test DISCOVERY_TIMEOUT 60)
+gtest_discover_tests(robust_test NO_PRETTY_VALUES DISCOVERY_TIMEOUT 60)
 
 # The full-length versions, on request: cmake -DMJTETHER_LONG_TESTS=ON, then ctest -L long.
 option(MJTETHER_LONG_TESTS "Register the full-length (label long) tests" OFF)
@@ -23,7 +23,7 @@ endif()
 
 add_executable(stress_test stress_test.cc)
 target_link_libraries(stress_test PRIVATE mjtether_plugin GTest::gtest_main)
-gtest_discover_tests(stress_test DISCOVERY_TIMEOUT 60)
+gtest_discover_tests(stress_test NO_PRETTY_VALUES DISCOVERY_TIMEOUT 60)
 
 # valgrind on the command line: a short run of the default scene and a bad declaration, no
 # memory error and no definite or indirect leak (valgrind exits 9 then). Skipped in the

@@ -9,4 +9,4 @@ target_compile_definitions(sweep_test PRIVATE
   MJTETHER_MODELS_DIR="${PROJECT_SOURCE_DIR}/models"
   MJTETHER_CLI="$<TARGET_FILE:mjtether>")
 add_dependencies(sweep_test mjtether)
-gtest_discover_tests(sweep_test DISCOVERY_TIMEOUT 60 PROPERTIES LABELS sweep)
+gtest_discover_tests(sweep_test NO_PRETTY_VALUES DISCOVERY_TIMEOUT 60 PROPERTIES LABELS sweep)

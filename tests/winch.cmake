@@ -3,15 +3,15 @@
 # Cost per inserted node: tests/bench/bench_winch (not a timed test).
 add_executable(winch_test winch_test.cc)
 target_link_libraries(winch_test PRIVATE mjtether_plugin GTest::gtest_main)
-gtest_discover_tests(winch_test DISCOVERY_TIMEOUT 60)
+gtest_discover_tests(winch_test NO_PRETTY_VALUES DISCOVERY_TIMEOUT 60)
 # Quasi-static payout in a cross current against an independent static-cable (shooting) reference.
 add_executable(winch_current_test winch_current_test.cc)
 target_link_libraries(winch_current_test PRIVATE mjtether_plugin GTest::gtest_main)
-gtest_discover_tests(winch_current_test DISCOVERY_TIMEOUT 60)
+gtest_discover_tests(winch_current_test NO_PRETTY_VALUES DISCOVERY_TIMEOUT 60)
 # The winch's reaction on a free TMS body (momentum against the reported drum force).
 add_executable(winch_body_test winch_body_test.cc)
 target_link_libraries(winch_body_test PRIVATE mjtether_plugin GTest::gtest_main)
-gtest_discover_tests(winch_body_test DISCOVERY_TIMEOUT 60)
+gtest_discover_tests(winch_body_test NO_PRETTY_VALUES DISCOVERY_TIMEOUT 60)
 
 # The controller example's winch mode (examples/rov_pid.cc --winch): a PID flies the BlueROV2
 # 20 m down-range while the boat's reel holds 10 N; exit status 0 only if the depth stayed within
