@@ -397,6 +397,7 @@ bool Tether::RestOnLevel(const Ends& ends, double zb, Nodes x) const {
     return true;
   }
   const bool chords = Has(kCompression);
+  const bool flat = !w.surface.declared();
   // Places node k (k = first..last) a chord L0 from node k-1 at the first point of the path
   // beyond node k-1's arc position (path(s): a point of the path at arc position s of the flat
   // path, s <= end). Returns the number of nodes placed (fewer when the path ran out).
@@ -405,17 +406,37 @@ bool Tether::RestOnLevel(const Ends& ends, double zb, Nodes x) const {
     for (int k = first; k <= last; ++k) {
       const Vec3 c = x.col(k - 1);
       const double ds = 0.25 * L0_;
-      double lo = s, hi = s;
-      // March (a chord is at most the arc between its ends, but a lifted path is longer than
-      // its flat arc) to a point at least L0 away, then bisect back to the first crossing.
+      // March to a point at least L0 away, then solve back for the first crossing. A chord is
+      // at most its arc, so on a flat path the march starts one L0 of arc on; a path lifted
+      // onto a geom seabed is longer than its flat arc, so there it starts at node k-1.
+      double lo = flat ? std::min(s + L0_, end) : s, hi = lo;
       while ((path(hi) - c).norm() < L0_) {
         if (hi >= end) return k - first;
         lo = hi;
         hi = std::min(hi + ds, end);
       }
+      // Regula falsi (Illinois) on |path(s) - c| - L0, bisecting outside the bracket.
+      double glo = (path(lo) - c).norm() - L0_, ghi = (path(hi) - c).norm() - L0_;
+      int side = 0;
       for (int it = 0; it < 200 && hi - lo > 1e-15 * (hi + L0_); ++it) {
-        const double mid = 0.5 * (lo + hi);
-        ((path(mid) - c).norm() < L0_ ? lo : hi) = mid;
+        double mid = (lo * ghi - hi * glo) / (ghi - glo);
+        if (!(mid > lo && mid < hi)) mid = 0.5 * (lo + hi);
+        const double gm = (path(mid) - c).norm() - L0_;
+        if (std::abs(gm) <= 1e-14 * L0_) {
+          hi = mid;
+          break;
+        }
+        if (gm < 0) {
+          lo = mid;
+          glo = gm;
+          if (side == -1) ghi *= 0.5;
+          side = -1;
+        } else {
+          hi = mid;
+          ghi = gm;
+          if (side == 1) glo *= 0.5;
+          side = 1;
+        }
       }
       s = hi;
       x.col(k) = path(s);
@@ -494,8 +515,8 @@ bool Tether::RestOnLevel(const Ends& ends, double zb, Nodes x) const {
   if (!chords) return true;
   // Chords of L0: F(Ls) = |B - node N-1| - L0 after walking nodes 1..N-1 along the path of
   // length Ls (-L0 per node the path ran short of), which grows with Ls; F(L) <= 0 on a flat
-  // path (each chord takes at least L0 of arc). Bracket and bisect; keep the arc spacing if
-  // that fails (back to the arc spacing).
+  // path (each chord takes at least L0 of arc). Bracket, then regula falsi; keep the arc
+  // spacing if that fails.
   auto F = [&](double Ls) {
     const Path q = make(Ls);
     const int placed = walk([&](double s) { return point(q, s); }, Ls, 1, N_ - 1);
@@ -506,10 +527,26 @@ bool Tether::RestOnLevel(const Ends& ends, double zb, Nodes x) const {
   for (double step = L0_; fhi < 0 && step < 1e3 * L; step *= 2) fhi = F(hi = lo + step);
   for (double step = L0_; flo > 0 && step < L; step *= 2) flo = F(lo = hi - step);
   bool ok = flo <= 0 && fhi >= 0;
-  for (int it = 0; ok && it < 200 && std::min(-flo, fhi) > 1e-12 * L0_; ++it) {
-    const double mid = 0.5 * (lo + hi), fm = F(mid);
-    (fm < 0 ? lo : hi) = mid;
-    (fm < 0 ? flo : fhi) = fm;
+  // Regula falsi with the Illinois modification (F is close to linear in Ls: a few steps),
+  // bisecting when the interpolated point falls outside the bracket.
+  double glo = flo, ghi = fhi;  // the values interpolated (halved on a stuck side)
+  int side = 0;
+  for (int it = 0; ok && it < 200 && std::min(-flo, fhi) > 1e-12 * L0_ && hi - lo > 1e-15 * L;
+       ++it) {
+    double mid = (lo * ghi - hi * glo) / (ghi - glo);
+    if (!(mid > lo && mid < hi)) mid = 0.5 * (lo + hi);
+    const double fm = F(mid);
+    if (fm < 0) {
+      lo = mid;
+      flo = glo = fm;
+      if (side == -1) ghi *= 0.5;
+      side = -1;
+    } else {
+      hi = mid;
+      fhi = ghi = fm;
+      if (side == 1) glo *= 0.5;
+      side = 1;
+    }
   }
   ok = ok && std::min(-flo, fhi) <= 1e-9 * L0_;
   if (ok) {
