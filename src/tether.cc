@@ -326,11 +326,11 @@ void Tether::InitialShape(const Ends& ends, double* xp, double* vp) const {
 // A shape that dips below the seabed is replaced by one that lies on it: the line hangs from
 // each end as a catenary whose lowest point touches the seabed with a horizontal tangent, and
 // the length in between lies flat on the seabed along the ends' horizontal direction (the
-// grounded part carries the horizontal tension a w unchanged, without friction). For an end at height h above the seabed, a
-// catenary of parameter a (horizontal tension / weight per length) reaches the seabed after
-// arc length s = sqrt(h^2 + 2 a h) and horizontal distance x = a acosh(1 + h/a) (Irvine,
-// "Cable Structures", 1981, ch. 1); one a for both ends (the horizontal tension is continuous
-// through a frictionless grounded part) solves
+// grounded part carries the horizontal tension a w unchanged, without friction). For an end at
+// height h above the seabed, a catenary of parameter a (horizontal tension / weight per length)
+// reaches the seabed after arc length s = sqrt(h^2 + 2 a h) and horizontal distance
+// x = a acosh(1 + h/a) (Irvine, "Cable Structures", 1981, ch. 1); one a for both ends (the
+// horizontal tension is continuous through a frictionless grounded part) solves
 //   s_A(a) + s_B(a) + (H - x_A(a) - x_B(a)) = L,
 // whose left side falls monotonically from h_A + h_B + H (a -> 0) to H (a -> inf), by bisection
 // on log a. When even vertical drops leave length over (L > h_A + h_B + H), the ends hang
@@ -340,33 +340,47 @@ void Tether::InitialShape(const Ends& ends, double* xp, double* vp) const {
 // lifted onto the seabed. A free end hangs down to the seabed and lies along its site's axis.
 //
 // A geom seabed (seabed.h) is met approximately: the shape above for a flat seabed at the
-// lower of the surface heights under the ends, then every node still below the surface
-// lifted vertically onto it (which stretches the segments over rough ground a little).
+// lower of the surface heights under the ends, with every point of it still below the surface
+// lifted vertically onto it (which stretches the segments over rough ground a little, unless
+// the nodes are placed by chords, below).
+//
+// Nodes go at arc spacing L0 along that path. The path has corners (where a catenary with a
+// small a, or a vertical drop, meets the seabed; the U's turns; the ground's bumps), and a
+// node next to a corner cuts it: its chord is shorter than L0 (an anchor 5 cm above the
+// seabed with 0.2 m segments: 0.79 L0). A slack segment exerts no force, but with EAc it
+// pushes (10.5 kN at EAc 5e4 there). So with EAc the nodes go a chord of exactly L0 apart
+// along the path (on its straight parts the same as arc spacing), which needs a longer path:
+// the path's length Ls is solved (bisection) so that node N lands on end B.
 void Tether::RestOnSeabed(const Ends& ends, Nodes x) const {
   const Water& w = env_.water;
-  if (!w.surface.declared()) {
-    RestOnLevel(ends, w.seabed, x);
-    return;
-  }
   double zb = w.SeabedHeight(ends.a.pos.x(), ends.a.pos.y());
-  if (!p_.free_end) zb = std::min(zb, w.SeabedHeight(ends.b.pos.x(), ends.b.pos.y()));
-  RestOnLevel(ends, zb, x);
+  if (w.surface.declared() && !p_.free_end)
+    zb = std::min(zb, w.SeabedHeight(ends.b.pos.x(), ends.b.pos.y()));
+  if (RestOnLevel(ends, zb, x) || !w.surface.declared()) return;
+  // Not replaced: lift the nodes of the shape as it is onto the surface's bumps.
   for (int k = 1; k <= N_; ++k) {
     if (k == N_ && !p_.free_end) break;
     x(2, k) = std::max(x(2, k), w.SeabedHeight(x(0, k), x(1, k)));
   }
 }
 
-void Tether::RestOnLevel(const Ends& ends, double zb, Nodes x) const {
+bool Tether::RestOnLevel(const Ends& ends, double zb, Nodes x) const {
+  const Water& w = env_.water;
   const double L = p_.length;
   bool below = false;
   for (int k = 0; k <= N_ && !below; ++k) below = x(2, k) < zb;
-  if (!below) return;
+  if (!below) return false;
   const Vec3 g = Weight(0).norm() > 0 ? Weight(0) : env_.gravity;
   const bool vertical = g.norm() > 0 && -g.z() >= (1 - 1e-9) * g.norm();
   const Vec3& A = ends.a.pos;
   const Vec3 ez = Vec3::UnitZ();
   const double hA = A.z() - zb;
+  // A point of the path on the seabed level zb, lifted onto the geom seabed's surface.
+  auto ground = [&](Vec3 p) -> Vec3 {
+    p.z() = std::max(p.z(), zb);
+    if (w.surface.declared()) p.z() = std::max(p.z(), w.SeabedHeight(p.x(), p.y()));
+    return p;
+  };
   // Horizontal direction of the grounded part: towards B, else along site A's axis, else x.
   auto horizontal = [](const Vec3& d) {
     const Vec3 hd(d.x(), d.y(), 0);
@@ -374,16 +388,72 @@ void Tether::RestOnLevel(const Ends& ends, double zb, Nodes x) const {
   };
   if (!vertical || hA < 0 || (!p_.free_end && ends.b.pos.z() < zb)) {
     for (int k = 0; k <= N_; ++k) x(2, k) = std::max(x(2, k), zb);
-    return;
+    if (w.surface.declared()) {
+      for (int k = 1; k <= N_; ++k) {
+        if (k == N_ && !p_.free_end) break;
+        x(2, k) = std::max(x(2, k), w.SeabedHeight(x(0, k), x(1, k)));
+      }
+    }
+    return true;
   }
+  const bool chords = Has(kCompression);
+  const bool flat = !w.surface.declared();
+  // Places node k (k = first..last) a chord L0 from node k-1 at the first point of the path
+  // beyond node k-1's arc position (path(s): a point of the path at arc position s of the flat
+  // path, s <= end). Returns the number of nodes placed (fewer when the path ran out).
+  auto walk = [&](auto&& path, double end, int first, int last) -> int {
+    double s = 0;
+    for (int k = first; k <= last; ++k) {
+      const Vec3 c = x.col(k - 1);
+      const double ds = 0.25 * L0_;
+      // March to a point at least L0 away, then solve back for the first crossing. A chord is
+      // at most its arc, so on a flat path the march starts one L0 of arc on; a path lifted
+      // onto a geom seabed is longer than its flat arc, so there it starts at node k-1.
+      double lo = flat ? std::min(s + L0_, end) : s, hi = lo;
+      while ((path(hi) - c).norm() < L0_) {
+        if (hi >= end) return k - first;
+        lo = hi;
+        hi = std::min(hi + ds, end);
+      }
+      // Regula falsi (Illinois) on |path(s) - c| - L0, bisecting outside the bracket.
+      double glo = (path(lo) - c).norm() - L0_, ghi = (path(hi) - c).norm() - L0_;
+      int side = 0;
+      for (int it = 0; it < 200 && hi - lo > 1e-15 * (hi + L0_); ++it) {
+        double mid = (lo * ghi - hi * glo) / (ghi - glo);
+        if (!(mid > lo && mid < hi)) mid = 0.5 * (lo + hi);
+        const double gm = (path(mid) - c).norm() - L0_;
+        if (std::abs(gm) <= 1e-14 * L0_) {
+          hi = mid;
+          break;
+        }
+        if (gm < 0) {
+          lo = mid;
+          glo = gm;
+          if (side == -1) ghi *= 0.5;
+          side = -1;
+        } else {
+          hi = mid;
+          ghi = gm;
+          if (side == 1) glo *= 0.5;
+          side = 1;
+        }
+      }
+      s = hi;
+      x.col(k) = path(s);
+    }
+    return last - first + 1;
+  };
   const Vec3 A0(A.x(), A.y(), zb);  // end A projected on the seabed
   if (p_.free_end) {
     const Vec3 eh = horizontal(ends.a.axis);
-    for (int k = 0; k <= N_; ++k) {
-      const double s = L * k / N_;
-      x.col(k) = s <= hA ? Vec3(A - s * ez) : Vec3(A0 + (s - hA) * eh);
-    }
-    return;
+    auto path = [&](double s) {
+      return ground(s <= hA ? Vec3(A - s * ez) : Vec3(A0 + (s - hA) * eh));
+    };
+    for (int k = 0; k <= N_; ++k) x.col(k) = path(L * k / N_);
+    x.col(0) = A;
+    // The path goes on along eh without end: the walk always places every node.
+    if (chords) walk(path, 1e3 * L + 1e3, 1, N_);
+    return true;
   }
   const Vec3& B = ends.b.pos;
   const double hB = B.z() - zb;
@@ -396,44 +466,97 @@ void Tether::RestOnLevel(const Ends& ends, double zb, Nodes x) const {
     *s = std::sqrt(h * h + 2 * a * h);
     *xh = a > 0 ? a * std::acosh(1 + h / a) : 0;
   };
-  double a = 0, sA = hA, sB = hB, xA = 0, xB = 0, detour = 0;
-  if (L >= hA + hB + H) {
-    detour = 0.5 * (L - hA - hB - H);
-  } else {
-    double lo = std::log(1e-12 * L), hi = std::log(1e12 * L);
-    for (int it = 0; it < 200; ++it) {
-      const double mid = 0.5 * (lo + hi);
-      hang(std::exp(mid), hA, &sA, &xA);
-      hang(std::exp(mid), hB, &sB, &xB);
-      (sA + sB + H - xA - xB > L ? lo : hi) = mid;
-    }
-    a = std::exp(0.5 * (lo + hi));
-    hang(a, hA, &sA, &xA);
-    hang(a, hB, &sB, &xB);
-  }
-  const double run = std::max(0.0, H - xA - xB);  // grounded length along eh
-  const Vec3 TA = A0 + xA * eh, TB = B0 - xB * eh;  // touchdown points
-  // A point of a hanging part at arc length sigma from its touchdown point T, going along dir.
-  auto hanging = [&](const Vec3& T, const Vec3& dir, double sigma) -> Vec3 {
-    const double u = a > 0 ? a * std::asinh(sigma / a) : 0;
-    return T + u * dir + (std::sqrt(a * a + sigma * sigma) - a) * ez;
+  // The flat path of length Ls: catenary parameter a, hanging lengths, U detour, grounded run.
+  struct Path {
+    double Ls, a = 0, sA, sB, xA = 0, xB = 0, detour = 0, run;
   };
-  for (int k = 1; k < N_; ++k) {
-    const double s = L * k / N_;
-    if (s <= sA) {
-      x.col(k) = hanging(TA, -eh, sA - s);
-    } else if (s >= L - sB) {
-      x.col(k) = hanging(TB, eh, s - (L - sB));
+  auto make = [&](double Ls) {
+    Path p;
+    p.Ls = Ls;
+    p.sA = hA;
+    p.sB = hB;
+    if (Ls >= hA + hB + H) {
+      p.detour = 0.5 * (Ls - hA - hB - H);
     } else {
-      const double r = s - sA;  // along the grounded part: out by `detour`, along, back
-      x.col(k) = r < detour         ? Vec3(TA + r * en)
-                 : r < detour + run ? Vec3(TA + detour * en + (r - detour) * eh)
-                                    : Vec3(TA + (2 * detour + run - r) * en + run * eh);
+      double lo = std::log(1e-12 * L), hi = std::log(1e12 * L);
+      for (int it = 0; it < 200; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        hang(std::exp(mid), hA, &p.sA, &p.xA);
+        hang(std::exp(mid), hB, &p.sB, &p.xB);
+        (p.sA + p.sB + H - p.xA - p.xB > Ls ? lo : hi) = mid;
+      }
+      p.a = std::exp(0.5 * (lo + hi));
+      hang(p.a, hA, &p.sA, &p.xA);
+      hang(p.a, hB, &p.sB, &p.xB);
     }
-    x(2, k) = std::max(x(2, k), zb);  // round-off
+    p.run = std::max(0.0, H - p.xA - p.xB);  // grounded length along eh
+    return p;
+  };
+  // The point at arc position s (0 <= s <= Ls) of path p, lifted onto the ground.
+  auto point = [&](const Path& p, double s) -> Vec3 {
+    const Vec3 TA = A0 + p.xA * eh, TB = B0 - p.xB * eh;  // touchdown points
+    // A point of a hanging part at arc length sigma from its touchdown point T, along dir.
+    auto hanging = [&](const Vec3& T, const Vec3& dir, double sigma) -> Vec3 {
+      const double u = p.a > 0 ? p.a * std::asinh(sigma / p.a) : 0;
+      return T + u * dir + (std::sqrt(p.a * p.a + sigma * sigma) - p.a) * ez;
+    };
+    if (s <= p.sA) return ground(hanging(TA, -eh, p.sA - s));
+    if (s >= p.Ls - p.sB) return ground(hanging(TB, eh, std::min(s, p.Ls) - (p.Ls - p.sB)));
+    const double r = s - p.sA;  // along the grounded part: out by `detour`, along, back
+    const double d = p.detour, run = p.run;
+    return ground(r < d         ? Vec3(TA + r * en)
+                  : r < d + run ? Vec3(TA + d * en + (r - d) * eh)
+                                : Vec3(TA + (2 * d + run - r) * en + run * eh));
+  };
+  const Path p = make(L);
+  for (int k = 1; k < N_; ++k) x.col(k) = point(p, L * k / N_);
+  x.col(0) = A;
+  x.col(N_) = B;
+  if (!chords) return true;
+  // Chords of L0: F(Ls) = |B - node N-1| - L0 after walking nodes 1..N-1 along the path of
+  // length Ls (-L0 per node the path ran short of), which grows with Ls; F(L) <= 0 on a flat
+  // path (each chord takes at least L0 of arc). Bracket, then regula falsi; keep the arc
+  // spacing if that fails.
+  auto F = [&](double Ls) {
+    const Path q = make(Ls);
+    const int placed = walk([&](double s) { return point(q, s); }, Ls, 1, N_ - 1);
+    if (placed < N_ - 1) return -L0_ * (N_ - placed);
+    return (B - x.col(N_ - 1)).norm() - L0_;
+  };
+  double lo = L, hi = L, flo = F(L), fhi = flo;
+  for (double step = L0_; fhi < 0 && step < 1e3 * L; step *= 2) fhi = F(hi = lo + step);
+  for (double step = L0_; flo > 0 && step < L; step *= 2) flo = F(lo = hi - step);
+  bool ok = flo <= 0 && fhi >= 0;
+  // Regula falsi with the Illinois modification (F is close to linear in Ls: a few steps),
+  // bisecting when the interpolated point falls outside the bracket.
+  double glo = flo, ghi = fhi;  // the values interpolated (halved on a stuck side)
+  int side = 0;
+  for (int it = 0; ok && it < 200 && std::min(-flo, fhi) > 1e-12 * L0_ && hi - lo > 1e-15 * L;
+       ++it) {
+    double mid = (lo * ghi - hi * glo) / (ghi - glo);
+    if (!(mid > lo && mid < hi)) mid = 0.5 * (lo + hi);
+    const double fm = F(mid);
+    if (fm < 0) {
+      lo = mid;
+      flo = glo = fm;
+      if (side == -1) ghi *= 0.5;
+      side = -1;
+    } else {
+      hi = mid;
+      fhi = ghi = fm;
+      if (side == 1) glo *= 0.5;
+      side = 1;
+    }
+  }
+  ok = ok && std::min(-flo, fhi) <= 1e-9 * L0_;
+  if (ok) {
+    F(-flo < fhi ? lo : hi);
+  } else {
+    for (int k = 1; k < N_; ++k) x.col(k) = point(p, L * k / N_);
   }
   x.col(0) = A;
   x.col(N_) = B;
+  return true;
 }
 
 }  // namespace mjtether

@@ -262,7 +262,8 @@ class Tether {
                                 bool to_stage) const;
 
   void RestOnSeabed(const Ends& ends, Nodes x) const;
-  void RestOnLevel(const Ends& ends, double zb, Nodes x) const;
+  // Replaces a shape below the level zb (true), or leaves it (false).
+  bool RestOnLevel(const Ends& ends, double zb, Nodes x) const;
 
   // Integrators (one step of size h; ends already set at the start, `next` at the end).
   void PlaceEnds(const Ends& e, Nodes x, Nodes v) const;
