@@ -389,6 +389,9 @@ void EvaluateLead(const mjModel* m, mjData* d, const AttachedTether& at, double*
   to.a.pos += dt * now.a.vel;
   to.b.pos += dt * now.b.vel;
   from.body_b = to.body_b = &body;
+  // The interval's times: with bdf2 end node B steps over it by backward Euler (ImplicitStep).
+  from.time = c[kLeadTime];
+  to.time = c[kLeadTime] + dt;
   const StepStatus status = tether.Advance(x.data(), v.data(), from, to, dt, work, history);
   c[kLeadTime] = d->time + h;
   if (!status.ok) return RecordFailure(u, status, d->time);

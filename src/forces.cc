@@ -99,7 +99,7 @@ void Tether::AddAxial(ConstNodes x, ConstNodes v, ConstNodes t, const double* l,
       // On the other side of L0 at the start of the step than now?
       const double ls2 = (start->x.col(j + 1) - start->x.col(j)).squaredNorm();
       if (l[j] > L0_ ? ls2 <= L0sq : l[j] < L0_ && ls2 >= L0sq) engage_h = start->h;
-      if (start->discrete && !(start->mixed_end && j == N_ - 1)) {
+      if (start->discrete) {
         // In the Newton iterations past the first: the backward difference of the engaged
         // strain over the step, (eps+ - max(eps_start, 0))/h (see ImplicitStep).
         const double ls = std::sqrt(ls2);

@@ -157,18 +157,20 @@ void Tether::Rk4Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double
 // (3x3 blocks, two off-diagonals with bending, one without): a block Cholesky with fixed-size
 // 3x3 blocks (block_band.h) solves it, assembled directly block by block.
 bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
-                          double* work, StepStatus* stats, double h_b) const {
-  (void)now;
+                          double* work, StepStatus* stats) const {
   Work w(work, N_);
   const int n = N_ + 1;
   const int nu = N_ - 1 + (DynamicB() ? 1 : 0);  // dynamic nodes 1..nu, unknown u = i - 1
   // A body at end B (consistent coupling): its effective mass and force join end node B's.
   const EndInertia* body = dynamic_b_ ? next.body_b : nullptr;
-  // The step of each node [s]: h, but h_b for end node B with a body (bdf2's mixed step, see
-  // Bdf2Step: the other nodes take BDF2's backward-Euler step of he from their extrapolated
-  // state, end node B a plain backward-Euler step of h from its own).
-  const double hN = body && h_b > 0 ? h_b : h;
-  const bool mixed = hN != h;
+  // The step of each node [s]: h, but with bdf2 and a body at end B the interval's own length,
+  // next.time - now.time, for end node B (the mixed step, see Bdf2Step: the other nodes take
+  // BDF2's backward-Euler step of he from their extrapolated state, end node B a plain
+  // backward-Euler step over the interval from its own state; EvaluateLead sets the times).
+  const double span = next.time - now.time;  // [s]
+  const bool mixed = body && p_.integrator == Integrator::kBdf2 && span > 0 &&
+                     std::abs(span - h) > 1e-9 * h;
+  const double hN = mixed ? span : h;
   auto step = [&](int i) { return i == N_ ? hN : h; };
   Nodes xk(w.x2, 3, n), vk(w.v2, 3, n);
   // Initial iterate: velocities unchanged, ends at the end of the step.
@@ -193,7 +195,7 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   const Mat3 I = Mat3::Identity();
   const double h2 = h * h;
   const bool added = Has(kAddedMass);
-  Start start{ConstNodes(x.data(), 3, n), h, false, mixed};
+  Start start{ConstNodes(x.data(), 3, n), h, false};
   const double body_min_mass =
       body ? Eigen::SelfAdjointEigenSolver<Mat3>(body->mass, Eigen::EigenvaluesOnly)
                  .eigenvalues()
@@ -267,30 +269,42 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         const bool taut = w.l[j] > L0;
         if (!taut && !(compression && w.l[j] > 0 && w.l[j] < L0)) continue;
         const Vec3 tj = t.col(j);
-        const Mat3 tt = tj * tj.transpose();
-        Mat3 K;       // [N/m] stiffness
-        double c = 0;  // [kg/s] damping along t
+        Mat3 B;
+        double c = 0;  // [kg/s] the damping along t in B
         if (taut) {
           // In the Newton iterations after the first, a taut segment whose damped tension is
           // clipped at zero (it shortens faster than EA eps/damping) is on the piece where
           // the law is 0: its Jacobian there is 0 (the first keeps the linearly implicit step's
           // matrix of before).
           if (newton && !(w.T[j] > 0)) continue;
-          const double geo = w.T[j] / w.l[j];
-          K = (ka - geo) * tt + geo * I;
           c = w.T[j] > 0 ? ca : 0;
+          const double geo = h2 * w.T[j] / w.l[j];
+          const double along = h2 * ka + h * c - geo;
+          B = along * tj * tj.transpose() + geo * I;
         } else {
           const double rate = tj.dot(vk.col(j + 1) - vk.col(j)) / L0;  // [1/s] deps/dt
           const bool pushes = p_.EAc * (w.l[j] / L0 - 1) + ca * L0 * rate < 0;
-          K = kc * tt;
           c = pushes ? ca : 0;
+          B = (h2 * kc + h * c) * tj * tj.transpose();
         }
-        const double s0 = step(j), s1 = step(j + 1);
         const bool d0 = Dynamic(j), d1 = Dynamic(j + 1);
-        if (d0) A.D(j - 1) += s0 * s0 * K + (s0 * c) * tt;
-        if (d1) A.D(j) += s1 * s1 * K + (s1 * c) * tt;
-        if (d0 && d1) A.L1(j) -= s0 * s1 * K + (s0 * c) * tt;
-        if (mixed && d0 && d1 && j + 1 == N_) end_t = tj, end_c = (s1 - s0) * c;
+        if (mixed && j + 1 == N_) {
+          // The end segment of a mixed step, node j stepping h and end node B hN: B = h^2 K +
+          // h c t t^T, so K = (B - h c t t^T)/h^2; the blocks s_i s_j K + s_i c t t^T.
+          const Mat3 ct = c * tj * tj.transpose();
+          const Mat3 K = (B - h * ct) / h2;
+          if (d0) A.D(j - 1) += B;
+          A.D(j) += hN * hN * K + hN * ct;
+          if (d0) {
+            A.L1(j) -= h * hN * K + h * ct;
+            end_t = tj;
+            end_c = (hN - h) * c;
+          }
+          continue;
+        }
+        if (d0) A.D(j - 1) += B;
+        if (d1) A.D(j) += B;
+        if (d0 && d1) A.L1(j) -= B;
       }
     }
     // Bending: K = -EI/w g g^T I on the stencil of each curvature; B = h^2 EI/(w L0^2) g g^T I.
@@ -300,13 +314,15 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
       double* band0 = w.M;  // 3 x n scratch (the moments are no longer needed): D, L1, L2
       std::fill(band0, band0 + 3 * n, 0.0);
       auto stencil = [&](int first, const double* g, int count, double weight) {
-        const double k = p_.EI / (weight * L0_ * L0_);
+        const double k = h2 * p_.EI / (weight * L0_ * L0_);
         for (int a = 0; a < count; ++a) {
           const int ia = first + a;
           if (!Dynamic(ia)) continue;
           for (int b = 0; b <= a; ++b) {
             if (!Dynamic(first + b)) continue;
-            band0[3 * (ia - 1) + (a - b)] += step(ia) * step(first + b) * k * g[a] * g[b];
+            // With per-node steps s_i: s_ia s_ib K, i.e. h^2 K scaled where end node B is in.
+            const double scale = mixed ? step(ia) * step(first + b) / h2 : 1;
+            band0[3 * (ia - 1) + (a - b)] += scale * k * g[a] * g[b];
           }
         }
       };
@@ -529,7 +545,10 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   for (int j = 0; j < N_; ++j) T_max = std::max(T_max, w.T[j]);
   const double tolerance =
       kNewtonTolerance * std::sqrt(dv_max) + 1e-12 * h * (2 * T_max + W_max) / m_min;
-  start.discrete = true;
+  // Not on a mixed step: the end segment's backward difference of the strain would need a
+  // common start, which its two nodes (stepping he from x-hat and h from x) do not have; the
+  // damping stays on the node velocities there, as in the first iteration.
+  start.discrete = !mixed;
   phi = residual(&err);
   newton = true;
   for (int iter = 1; err > tolerance; ++iter) {
@@ -733,14 +752,15 @@ void Tether::Bdf2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, doubl
   // A body at end B (the consistent coupling, docs/coupling.md): end node B carries the body,
   // which must not take on BDF2's history (its spurious root kept a body accelerating after
   // the tether went slack); it takes a backward-Euler step of h from its own state, the other
-  // nodes BDF2's (the mixed step of ImplicitStep).
-  const bool mixed = dynamic_b_ && next.body_b;
+  // nodes BDF2's (the mixed step of ImplicitStep, which takes the interval from the ends'
+  // times).
+  const bool mixed = dynamic_b_ && next.body_b && next.time > now.time;
   for (int i = 0; i < n; ++i) {
     if (!Dynamic(i) || (mixed && i == N_)) continue;
     x.col(i) += c * dx.col(i);
     v.col(i) += c * dv.col(i);
   }
-  if (!ImplicitStep(x, v, now, next, he, work, stats, mixed ? h : 0)) {
+  if (!ImplicitStep(x, v, now, next, he, work, stats)) {
     x = xs;
     v = vs;
     return backward_euler();

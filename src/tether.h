@@ -230,8 +230,6 @@ class Tether {
     double h;      // [s]
     bool discrete;  // damping on the backward difference of the strain over the step
                     // (the Newton iterations past the first, see ImplicitStep)
-    bool mixed_end = false;  // end node B steps by another h (bdf2's mixed step): the end
-                             // segment's damping stays on the velocities (no common start)
   };
   // ComputeForces, with the implicit step's start when `start` is not null.
   void Forces(const double* x, const double* v, const Ends& ends, double* f, double* T,
@@ -273,10 +271,8 @@ class Tether {
                     double* work) const;
   void Rk4Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
                double* work) const;
-  // h_b > 0: end node B with a body (Ends::body_b) takes a step of h_b instead of h, from its
-  // own x and v (bdf2's mixed step, see Bdf2Step).
   bool ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
-                    double* work, StepStatus* stats, double h_b = 0) const;
+                    double* work, StepStatus* stats) const;
   void ImplicitStepAdaptive(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
                             int depth, double* work, StepStatus* stats,
                             double impulse_weight = 1) const;
