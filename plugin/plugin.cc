@@ -310,8 +310,9 @@ void CountStalls(const StepStatus& status, double time, double* u) {
 // The consistent coupling is used from this coupling omega h on (docs/coupling.md): below it
 // the held force is accurate (BlueROV2 at EA 6e4, omega h 0.26: 0.65% in tension) and the
 // consistent one, which integrates the body-end mode with backward Euler, damps that mode
-// (2.3%). Only integrator=implicit: with bdf2 the body takes on the scheme's history (its
-// spurious root kept accelerating a body after a snap: 0.68 N s from nothing).
+// (2.3%). integrator=implicit and bdf2 (whose end node B takes a backward-Euler step inside
+// the BDF2 step: with BDF2's history the body kept accelerating after a snap, 0.68 N s from
+// nothing); not implicit2 (it lost the anchor's impulse).
 constexpr double kLeadFrom = 1;
 
 // A tether with the consistent coupling at end B (AttachedTether::lead; docs/coupling.md).
@@ -388,6 +389,9 @@ void EvaluateLead(const mjModel* m, mjData* d, const AttachedTether& at, double*
   to.a.pos += dt * now.a.vel;
   to.b.pos += dt * now.b.vel;
   from.body_b = to.body_b = &body;
+  // The interval's times: with bdf2 end node B steps over it by backward Euler (ImplicitStep).
+  from.time = c[kLeadTime];
+  to.time = c[kLeadTime] + dt;
   const StepStatus status = tether.Advance(x.data(), v.data(), from, to, dt, work, history);
   c[kLeadTime] = d->time + h;
   if (!status.ok) return RecordFailure(u, status, d->time);
@@ -1203,7 +1207,8 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
                 : p.integrator == Integrator::kImplicit2 ? kCouplingLimitImplicit2
                                                          : 0;
       // The consistent coupling (EvaluateLead) where the held force is not resolved.
-      if (end == 1 && c.omega_h >= kLeadFrom && p.integrator == Integrator::kImplicit &&
+      if (end == 1 && c.omega_h >= kLeadFrom &&
+          (p.integrator == Integrator::kImplicit || p.integrator == Integrator::kBdf2) &&
           !at.coupled[0] && !at.winch && !at.contact && !p.clamp_b &&
           FreeCarrier(m, at.body[1]) > 0 && m->opt.integrator != mjINT_RK4) {
         at.lead = t.WithDynamicEndB();

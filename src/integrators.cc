@@ -158,12 +158,20 @@ void Tether::Rk4Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double
 // 3x3 blocks (block_band.h) solves it, assembled directly block by block.
 bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
                           double* work, StepStatus* stats) const {
-  (void)now;
   Work w(work, N_);
   const int n = N_ + 1;
   const int nu = N_ - 1 + (DynamicB() ? 1 : 0);  // dynamic nodes 1..nu, unknown u = i - 1
   // A body at end B (consistent coupling): its effective mass and force join end node B's.
   const EndInertia* body = dynamic_b_ ? next.body_b : nullptr;
+  // The step of each node [s]: h, but with bdf2 and a body at end B the interval's own length,
+  // next.time - now.time, for end node B (the mixed step, see Bdf2Step: the other nodes take
+  // BDF2's backward-Euler step of he from their extrapolated state, end node B a plain
+  // backward-Euler step over the interval from its own state; EvaluateLead sets the times).
+  const double span = next.time - now.time;  // [s]
+  const bool mixed = body && p_.integrator == Integrator::kBdf2 && span > 0 &&
+                     std::abs(span - h) > 1e-9 * h;
+  const double hN = mixed ? span : h;
+  auto step = [&](int i) { return i == N_ ? hN : h; };
   Nodes xk(w.x2, 3, n), vk(w.v2, 3, n);
   // Initial iterate: velocities unchanged, ends at the end of the step.
   vk = v;
@@ -171,6 +179,7 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   if (!DynamicB()) vk.col(N_) = next.b.vel;
   auto place = [&]() {
     xk = x + h * vk;
+    if (mixed) xk.col(N_) = x.col(N_) + hN * vk.col(N_);
     xk.col(0) = next.a.pos;
     if (!DynamicB()) xk.col(N_) = next.b.pos;
   };
@@ -201,7 +210,7 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
     double phi = 0, worst = 0;
     for (int i = 1; i <= nu; ++i) {
       const Vec3 dvi = vk.col(i) - v.col(i);
-      Vec3 r = h * f.col(i) - Mass(i) * dvi;
+      Vec3 r = step(i) * f.col(i) - Mass(i) * dvi;
       if (added) {
         const Vec3 qi = q.col(i);
         r -= Added(i) * (dvi - qi.dot(dvi) * qi);
@@ -210,7 +219,7 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
       if (body && i == N_) {
         // The body's share: (W^-1 + m) dv = h (f + W^-1 a_other); G weighted by the inverse
         // of the smallest total mass along a direction.
-        r += h * body->force - body->mass * dvi;
+        r += hN * body->force - body->mass * dvi;
         inv = 1 / (Mass(i) + body_min_mass);
       }
       rhs.col(i - 1) = r;
@@ -240,7 +249,12 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
     }
     // Axial stiffness and damping of taut segments: B = h D + h^2 K with
     // K = EA/L0 t t^T + T/l (I - t t^T), D = damping/L0 t t^T; +B on both diagonal blocks,
-    // -B on the coupling block.
+    // -B on the coupling block. With per-node steps s_i (mixed): dG_i/dv_j = M_i d_ij -
+    // s_i K_ij s_j - s_i D_ij, symmetric in K but not in D on the end segment: the band holds
+    // s_{N-1} D there on both sides, and the rest, (s_N - s_{N-1}) D = (hN - h) ca t t^T in
+    // block row N, column N-1, is a rank-one term solved exactly by Sherman-Morrison below.
+    Vec3 end_t = Vec3::Zero();
+    double end_c = 0;  // [kg/s] the damping coefficient of that rank-one term
     // A compressed segment (compression effect, 0 < l < L0) adds h^2 EAc/L0 t t^T and its
     // damping while it pushes, without the geometric term -|T|/l (I - t t^T): that negative
     // stiffness (buckling) would make the matrix indefinite, and bending carries it instead.
@@ -256,21 +270,38 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         if (!taut && !(compression && w.l[j] > 0 && w.l[j] < L0)) continue;
         const Vec3 tj = t.col(j);
         Mat3 B;
+        double c = 0;  // [kg/s] the damping along t in B
         if (taut) {
           // In the Newton iterations after the first, a taut segment whose damped tension is
           // clipped at zero (it shortens faster than EA eps/damping) is on the piece where
           // the law is 0: its Jacobian there is 0 (the first keeps the linearly implicit step's
           // matrix of before).
           if (newton && !(w.T[j] > 0)) continue;
+          c = w.T[j] > 0 ? ca : 0;
           const double geo = h2 * w.T[j] / w.l[j];
-          const double along = h2 * ka + (w.T[j] > 0 ? h * ca : 0) - geo;
+          const double along = h2 * ka + h * c - geo;
           B = along * tj * tj.transpose() + geo * I;
         } else {
           const double rate = tj.dot(vk.col(j + 1) - vk.col(j)) / L0;  // [1/s] deps/dt
           const bool pushes = p_.EAc * (w.l[j] / L0 - 1) + ca * L0 * rate < 0;
-          B = (h2 * kc + (pushes ? h * ca : 0)) * tj * tj.transpose();
+          c = pushes ? ca : 0;
+          B = (h2 * kc + h * c) * tj * tj.transpose();
         }
         const bool d0 = Dynamic(j), d1 = Dynamic(j + 1);
+        if (mixed && j + 1 == N_) {
+          // The end segment of a mixed step, node j stepping h and end node B hN: B = h^2 K +
+          // h c t t^T, so K = (B - h c t t^T)/h^2; the blocks s_i s_j K + s_i c t t^T.
+          const Mat3 ct = c * tj * tj.transpose();
+          const Mat3 K = (B - h * ct) / h2;
+          if (d0) A.D(j - 1) += B;
+          A.D(j) += hN * hN * K + hN * ct;
+          if (d0) {
+            A.L1(j) -= h * hN * K + h * ct;
+            end_t = tj;
+            end_c = (hN - h) * c;
+          }
+          continue;
+        }
         if (d0) A.D(j - 1) += B;
         if (d1) A.D(j) += B;
         if (d0 && d1) A.L1(j) -= B;
@@ -289,7 +320,9 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
           if (!Dynamic(ia)) continue;
           for (int b = 0; b <= a; ++b) {
             if (!Dynamic(first + b)) continue;
-            band0[3 * (ia - 1) + (a - b)] += k * g[a] * g[b];
+            // With per-node steps s_i: s_ia s_ib K, i.e. h^2 K scaled where end node B is in.
+            const double scale = mixed ? step(ia) * step(first + b) / h2 : 1;
+            band0[3 * (ia - 1) + (a - b)] += scale * k * g[a] * g[b];
           }
         }
       };
@@ -319,7 +352,7 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         const double vq = vr.dot(qi);
         const Vec3 vn = vr - vq * qi;
         const double vnn = vn.norm();
-        const double ht = h * li;
+        const double ht = step(i) * li;
         Mat3 J = (ht * (kt_ * 2 * std::abs(vq) - kn_ * vnn)) * qi * qi.transpose();
         J.diagonal().array() += ht * kn_ * vnn;
         if (vnn > 0) J += (ht * kn_ / vnn) * vn * vn.transpose();
@@ -339,14 +372,15 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         if (pen <= 0) continue;
         BlockBand::Block d = A.D(i - 1);
         const Mat3 nn = n * n.transpose();
-        d += (h2 * seabed_k_ * Share(i) + h * seabed_c_ * Share(i)) * nn;
+        const double si = step(i);
+        d += (si * si * seabed_k_ * Share(i) + si * seabed_c_ * Share(i)) * nn;
         const double N =
             std::max(0.0, Share(i) * (seabed_k_ * pen - seabed_c_ * vk.col(i).dot(n)));
         const double mu = std::max(wt.seabed_friction, wt.seabed_friction_axial);
         const double vh = (vk.col(i) - vk.col(i).dot(n) * n).norm();
         const double eps = wt.seabed_friction_speed;
         const double secant = vh > 1e-9 * eps ? mu * N * std::tanh(vh / eps) / vh : mu * N / eps;
-        d += (h * secant) * (Mat3::Identity() - nn);
+        d += (si * secant) * (Mat3::Identity() - nn);
       }
     } else if (Has(kSeabed)) {
       const Water& wt = env_.water;
@@ -354,14 +388,15 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         const double pen = wt.seabed - xk(2, i);
         if (pen <= 0) continue;
         BlockBand::Block d = A.D(i - 1);
-        d(2, 2) += h2 * seabed_k_ * Share(i) + h * seabed_c_ * Share(i);
+        const double si = step(i);
+        d(2, 2) += si * si * seabed_k_ * Share(i) + si * seabed_c_ * Share(i);
         const double N = std::max(0.0, Share(i) * (seabed_k_ * pen - seabed_c_ * vk(2, i)));
         const double mu = std::max(wt.seabed_friction, wt.seabed_friction_axial);
         const double vh = std::hypot(vk(0, i), vk(1, i));
         const double eps = wt.seabed_friction_speed;
         const double secant = vh > 1e-9 * eps ? mu * N * std::tanh(vh / eps) / vh : mu * N / eps;
-        d(0, 0) += h * secant;
-        d(1, 1) += h * secant;
+        d(0, 0) += si * secant;
+        d(1, 1) += si * secant;
       }
     }
     // Contact: the penalty's stiffness k L0 K n n^T (K the 2 x 2 of ContactEval over the two
@@ -408,6 +443,17 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
     }
     if (A.Factor() >= 0) return false;
     A.Solve(w.rhs);
+    if (end_c != 0) {
+      // (A + u w^T) z = r with u = -end_c (e_N x t), w = e_{N-1} x t: z = A^-1 r - y (w.A^-1 r)
+      // / (1 + w.y), y = A^-1 u (Sherman-Morrison). Scratch: vb (the line search's start,
+      // set after each solve).
+      Nodes y(w.vb, 3, nu);
+      y.setZero();
+      y.col(nu - 1) = -end_c * end_t;
+      A.Solve(w.vb);
+      const double wy = end_t.dot(y.col(nu - 2)), wz = end_t.dot(rhs.col(nu - 2));
+      rhs -= (wz / (1 + wy)) * y;
+    }
     ++stats->newton_iterations;
     return true;
   };
@@ -499,7 +545,10 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   for (int j = 0; j < N_; ++j) T_max = std::max(T_max, w.T[j]);
   const double tolerance =
       kNewtonTolerance * std::sqrt(dv_max) + 1e-12 * h * (2 * T_max + W_max) / m_min;
-  start.discrete = true;
+  // Not on a mixed step: the end segment's backward difference of the strain would need a
+  // common start, which its two nodes (stepping he from x-hat and h from x) do not have; the
+  // damping stays on the node velocities there, as in the first iteration.
+  start.discrete = !mixed;
   phi = residual(&err);
   newton = true;
   for (int iter = 1; err > tolerance; ++iter) {
@@ -700,8 +749,14 @@ void Tether::Bdf2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, doubl
   const double he = h * (1 + ratio) / (1 + 2 * ratio);   // [s]
   xs = x;
   vs = v;
+  // A body at end B (the consistent coupling, docs/coupling.md): end node B carries the body,
+  // which must not take on BDF2's history (its spurious root kept a body accelerating after
+  // the tether went slack); it takes a backward-Euler step of h from its own state, the other
+  // nodes BDF2's (the mixed step of ImplicitStep, which takes the interval from the ends'
+  // times).
+  const bool mixed = dynamic_b_ && next.body_b && next.time > now.time;
   for (int i = 0; i < n; ++i) {
-    if (!Dynamic(i)) continue;
+    if (!Dynamic(i) || (mixed && i == N_)) continue;
     x.col(i) += c * dx.col(i);
     v.col(i) += c * dv.col(i);
   }
