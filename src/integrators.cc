@@ -246,12 +246,17 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
     // stiffness (buckling) would make the matrix indefinite, and bending carries it instead.
     if (Has(kAxial)) {
       const bool compression = Has(kCompression);
+      // The stiffness and damping per rest length, divided once, not per segment (the winch
+      // segment has its own rest length, divided at its turn).
+      const double ka0 = p_.EA / L0_, kc0 = p_.EAc / L0_;
+      const double ca0 = Has(kDamping) ? p_.damping / L0_ : 0;
       for (int j = 0; j < N_; ++j) {
         // The winch segment (a Deployed view) at its rest length at the end of the step.
-        const double L0 = j == 0 && head_ ? WinchRest(next) : L0_;
-        const double ka = p_.EA / L0;
-        const double kc = p_.EAc / L0;
-        const double ca = Has(kDamping) ? p_.damping / L0 : 0;
+        const bool winch = j == 0 && head_;
+        const double L0 = winch ? WinchRest(next) : L0_;
+        const double ka = winch ? p_.EA / L0 : ka0;
+        const double kc = winch ? p_.EAc / L0 : kc0;
+        const double ca = !Has(kDamping) ? 0 : winch ? p_.damping / L0 : ca0;
         const bool taut = w.l[j] > L0;
         if (!taut && !(compression && w.l[j] > 0 && w.l[j] < L0)) continue;
         const Vec3 tj = t.col(j);
@@ -429,15 +434,29 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   // of the largest tension (or a microstrain), the step was too long for the linearisation.
   // (Without this, the fixed line at 160 segments and 50 ms steps went wrong by 3.6 kN RMS,
   // not 60 N.)
+  // The tension test without a square root: EA/L0 (|d| - t . d) <= bound is |d| <= r with
+  // r = t . d + bound L0/EA, that is r >= 0 and |d|^2 <= r^2 (|d| >= t . d always, so r < 0
+  // misses more than the bound). A NaN passes the tension test, as it passed the max() before
+  // (the divergence check reports it). One pass over the segments does both tests with one d.
   const double L0sq = L0_ * L0_;
   auto linearisation_held = [&]() {
+    const bool axial = Has(kAxial);
+    double T_max = 0;
+    if (axial) {
+      for (int j = 0; j < N_; ++j) T_max = std::max(T_max, w.T[j]);
+    }
+    const double bound = std::max(kLinearisationTolerance * T_max, 1e-6 * p_.EA);  // [N]
     for (int j = 0; j < N_; ++j) {
-      if (j == 0 && head_) {
-        const double r = WinchRest(next);
-        if (((xk.col(1) - xk.col(0)).squaredNorm() > r * r) != (w.l[0] > r)) return false;
-        continue;
+      const bool winch = j == 0 && head_;
+      const double L0 = winch ? WinchRest(next) : L0_;
+      const Vec3 d = xk.col(j + 1) - xk.col(j);
+      const double d2 = d.squaredNorm();
+      const bool taut = w.l[j] > L0;
+      if ((d2 > (winch ? L0 * L0 : L0sq)) != taut) return false;
+      if (axial && taut) {
+        const double r = t.col(j).dot(d) + bound * L0 / p_.EA;  // [m]
+        if (r < 0 || d2 > r * r) return false;
       }
-      if (((xk.col(j + 1) - xk.col(j)).squaredNorm() > L0sq) != (w.l[j] > L0_)) return false;
     }
     // Friction saturates over the slip speed eps: where the slip of a contact changed the
     // friction's tanh by more than 0.1 in the full Newton step just taken (rhs still holds it),
@@ -462,16 +481,7 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         }
       }
     }
-    if (!Has(kAxial)) return true;
-    double T_max = 0, missed = 0;
-    for (int j = 0; j < N_; ++j) {
-      T_max = std::max(T_max, w.T[j]);
-      const double L0 = j == 0 && head_ ? WinchRest(next) : L0_;
-      if (!(w.l[j] > L0)) continue;
-      const Vec3 d = xk.col(j + 1) - xk.col(j);
-      missed = std::max(missed, p_.EA / L0 * (d.norm() - t.col(j).dot(d)));
-    }
-    return missed <= std::max(kLinearisationTolerance * T_max, 1e-6 * p_.EA);
+    return true;
   };
 
   // First iteration: the linearly implicit step.
