@@ -27,6 +27,14 @@ EndState Interpolate(const EndState& e0, const EndState& e1, double dt, double s
   return e;
 }
 
+// The lower triangle of a 3x3 block, column-major (m[r + 3 c] = m(r, c)): its 6 elements'
+// indices, rows and columns. BlockBand::Factor reads only the lower triangle of a diagonal
+// block (it is symmetric), so the implicit assembly computes and adds only these there.
+constexpr int kLowK[6] = {0, 1, 2, 4, 5, 8};
+constexpr int kLowR[6] = {0, 1, 2, 1, 2, 2};
+constexpr int kLowC[6] = {0, 0, 0, 1, 1, 2};
+constexpr double kI[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};  // the identity, column-major
+
 }  // namespace
 
 Ends Interpolate(const Ends& from, const Ends& to, double dt, double s) {
@@ -227,16 +235,27 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   bool newton = false;  // past the first iteration
   auto solve = [&]() {
     // The mass blocks are assigned, the coupling blocks zeroed: no pass over the whole band.
+    // The diagonal blocks are symmetric and Factor reads their lower triangle only: the mass,
+    // axial and drag terms compute and add those 6 elements (kLowK), each with the expression
+    // the full 3x3 product had for it (the same bits); the upper triangle is left as it was.
     A.SetZeroCoupling();
     for (int i = 1; i <= nu; ++i) {
-      BlockBand::Block d = A.D(i - 1);
+      double* d = A.D(i - 1).data();
+      const double m = Mass(i);
       if (added) {
-        const Vec3 qi = q.col(i);
-        d = Mass(i) * I + Added(i) * (I - qi * qi.transpose());
+        // M I + ma (I - q q^T)
+        const double ma = Added(i);
+        const double* qi = w.q + 3 * i;
+        for (int e = 0; e < 6; ++e) {
+          const int k = kLowK[e];
+          d[k] = m * kI[k] + ma * (kI[k] - qi[kLowR[e]] * qi[kLowC[e]]);
+        }
       } else {
-        d = Mass(i) * I;
+        for (int e = 0; e < 6; ++e) d[kLowK[e]] = m * kI[kLowK[e]];
       }
-      if (body && i == N_) d += body->mass;
+      if (body && i == N_) {
+        for (int e = 0; e < 6; ++e) d[kLowK[e]] += body->mass.data()[kLowK[e]];
+      }
     }
     // Axial stiffness and damping of taut segments: B = h D + h^2 K with
     // K = EA/L0 t t^T + T/l (I - t t^T), D = damping/L0 t t^T; +B on both diagonal blocks,
@@ -259,26 +278,43 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         const double ca = !Has(kDamping) ? 0 : winch ? p_.damping / L0 : ca0;
         const bool taut = w.l[j] > L0;
         if (!taut && !(compression && w.l[j] > 0 && w.l[j] < L0)) continue;
-        const Vec3 tj = t.col(j);
-        Mat3 B;
+        const double* tj = w.t + 3 * j;
+        // B = s t t^T + geo I; full (the coupling block is not symmetric to the bit: the
+        // products (s t_r) t_c and (s t_c) t_r may round apart).
+        double s, geo = 0;
         if (taut) {
           // In the Newton iterations after the first, a taut segment whose damped tension is
           // clipped at zero (it shortens faster than EA eps/damping) is on the piece where
           // the law is 0: its Jacobian there is 0 (the first keeps the linearly implicit step's
           // matrix of before).
           if (newton && !(w.T[j] > 0)) continue;
-          const double geo = h2 * w.T[j] / w.l[j];
-          const double along = h2 * ka + (w.T[j] > 0 ? h * ca : 0) - geo;
-          B = along * tj * tj.transpose() + geo * I;
+          geo = h2 * w.T[j] / w.l[j];
+          s = h2 * ka + (w.T[j] > 0 ? h * ca : 0) - geo;
         } else {
-          const double rate = tj.dot(vk.col(j + 1) - vk.col(j)) / L0;  // [1/s] deps/dt
+          const double rate = t.col(j).dot(vk.col(j + 1) - vk.col(j)) / L0;  // [1/s] deps/dt
           const bool pushes = p_.EAc * (w.l[j] / L0 - 1) + ca * L0 * rate < 0;
-          B = (h2 * kc + (pushes ? h * ca : 0)) * tj * tj.transpose();
+          s = h2 * kc + (pushes ? h * ca : 0);
+        }
+        double B[9];
+        for (int c = 0; c < 3; ++c) {
+          for (int r = 0; r < 3; ++r) B[r + 3 * c] = s * tj[r] * tj[c];
+        }
+        if (taut) {
+          for (int k = 0; k < 9; ++k) B[k] += geo * kI[k];
         }
         const bool d0 = Dynamic(j), d1 = Dynamic(j + 1);
-        if (d0) A.D(j - 1) += B;
-        if (d1) A.D(j) += B;
-        if (d0 && d1) A.L1(j) -= B;
+        if (d0) {
+          double* d = A.D(j - 1).data();
+          for (int e = 0; e < 6; ++e) d[kLowK[e]] += B[kLowK[e]];
+        }
+        if (d1) {
+          double* d = A.D(j).data();
+          for (int e = 0; e < 6; ++e) d[kLowK[e]] += B[kLowK[e]];
+        }
+        if (d0 && d1) {
+          double* c = A.L1(j).data();
+          for (int k = 0; k < 9; ++k) c[k] -= B[k];
+        }
       }
     }
     // Bending: K = -EI/w g g^T I on the stencil of each curvature; B = h^2 EI/(w L0^2) g g^T I.
@@ -325,10 +361,18 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         const Vec3 vn = vr - vq * qi;
         const double vnn = vn.norm();
         const double ht = h * li;
-        Mat3 J = (ht * (kt_ * 2 * std::abs(vq) - kn_ * vnn)) * qi * qi.transpose();
-        J.diagonal().array() += ht * kn_ * vnn;
-        if (vnn > 0) J += (ht * kn_ / vnn) * vn * vn.transpose();
-        A.D(i - 1) += J;
+        // J = s q q^T + ht kn |vn| I + (ht kn/|vn|) vn vn^T, lower triangle.
+        const double s = ht * (kt_ * 2 * std::abs(vq) - kn_ * vnn);
+        const double diag = ht * kn_ * vnn;
+        const double sn = vnn > 0 ? ht * kn_ / vnn : 0;
+        double* d = A.D(i - 1).data();
+        for (int e = 0; e < 6; ++e) {
+          const int r = kLowR[e], c = kLowC[e];
+          double J = s * qi[r] * qi[c];
+          if (r == c) J += diag;
+          if (vnn > 0) J += sn * vn[r] * vn[c];
+          d[kLowK[e]] += J;
+        }
       }
     }
     // Seabed: normal stiffness and damping, friction secant.
