@@ -27,6 +27,14 @@ EndState Interpolate(const EndState& e0, const EndState& e1, double dt, double s
   return e;
 }
 
+// The lower triangle of a 3x3 block, column-major (m[r + 3 c] = m(r, c)): its 6 elements'
+// indices, rows and columns. BlockBand::Factor reads only the lower triangle of a diagonal
+// block (it is symmetric), so the implicit assembly computes and adds only these there.
+constexpr int kLowK[6] = {0, 1, 2, 4, 5, 8};
+constexpr int kLowR[6] = {0, 1, 2, 1, 2, 2};
+constexpr int kLowC[6] = {0, 0, 0, 1, 1, 2};
+constexpr double kI[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};  // the identity, column-major
+
 }  // namespace
 
 Ends Interpolate(const Ends& from, const Ends& to, double dt, double s) {
@@ -236,16 +244,27 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   bool newton = false;  // past the first iteration
   auto solve = [&]() {
     // The mass blocks are assigned, the coupling blocks zeroed: no pass over the whole band.
+    // The diagonal blocks are symmetric and Factor reads their lower triangle only: the mass,
+    // axial and drag terms compute and add those 6 elements (kLowK), each with the expression
+    // the full 3x3 product had for it (the same bits); the upper triangle is left as it was.
     A.SetZeroCoupling();
     for (int i = 1; i <= nu; ++i) {
-      BlockBand::Block d = A.D(i - 1);
+      double* d = A.D(i - 1).data();
+      const double m = Mass(i);
       if (added) {
-        const Vec3 qi = q.col(i);
-        d = Mass(i) * I + Added(i) * (I - qi * qi.transpose());
+        // M I + ma (I - q q^T)
+        const double ma = Added(i);
+        const double* qi = w.q + 3 * i;
+        for (int e = 0; e < 6; ++e) {
+          const int k = kLowK[e];
+          d[k] = m * kI[k] + ma * (kI[k] - qi[kLowR[e]] * qi[kLowC[e]]);
+        }
       } else {
-        d = Mass(i) * I;
+        for (int e = 0; e < 6; ++e) d[kLowK[e]] = m * kI[kLowK[e]];
       }
-      if (body && i == N_) d += body->mass;
+      if (body && i == N_) {
+        for (int e = 0; e < 6; ++e) d[kLowK[e]] += body->mass.data()[kLowK[e]];
+      }
     }
     // Axial stiffness and damping of taut segments: B = h D + h^2 K with
     // K = EA/L0 t t^T + T/l (I - t t^T), D = damping/L0 t t^T; +B on both diagonal blocks,
@@ -260,51 +279,76 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
     // stiffness (buckling) would make the matrix indefinite, and bending carries it instead.
     if (Has(kAxial)) {
       const bool compression = Has(kCompression);
+      // The stiffness and damping per rest length, divided once, not per segment (the winch
+      // segment has its own rest length, divided at its turn).
+      const double ka0 = p_.EA / L0_, kc0 = p_.EAc / L0_;
+      const double ca0 = Has(kDamping) ? p_.damping / L0_ : 0;
       for (int j = 0; j < N_; ++j) {
         // The winch segment (a Deployed view) at its rest length at the end of the step.
-        const double L0 = j == 0 && head_ ? WinchRest(next) : L0_;
-        const double ka = p_.EA / L0;
-        const double kc = p_.EAc / L0;
-        const double ca = Has(kDamping) ? p_.damping / L0 : 0;
+        const bool winch = j == 0 && head_;
+        const double L0 = winch ? WinchRest(next) : L0_;
+        const double ka = winch ? p_.EA / L0 : ka0;
+        const double kc = winch ? p_.EAc / L0 : kc0;
+        const double ca = !Has(kDamping) ? 0 : winch ? p_.damping / L0 : ca0;
         const bool taut = w.l[j] > L0;
         if (!taut && !(compression && w.l[j] > 0 && w.l[j] < L0)) continue;
-        const Vec3 tj = t.col(j);
-        Mat3 B;
-        double c = 0;  // [kg/s] the damping along t in B
+        const double* tj = w.t + 3 * j;
+        // B = s t t^T + geo I; full (the coupling block is not symmetric to the bit: the
+        // products (s t_r) t_c and (s t_c) t_r may round apart).
+        double s, geo = 0;
+        double cd = 0;  // [kg/s] the damping along t in B (for the mixed step's end segment)
         if (taut) {
           // In the Newton iterations after the first, a taut segment whose damped tension is
           // clipped at zero (it shortens faster than EA eps/damping) is on the piece where
           // the law is 0: its Jacobian there is 0 (the first keeps the linearly implicit step's
           // matrix of before).
           if (newton && !(w.T[j] > 0)) continue;
-          c = w.T[j] > 0 ? ca : 0;
-          const double geo = h2 * w.T[j] / w.l[j];
-          const double along = h2 * ka + h * c - geo;
-          B = along * tj * tj.transpose() + geo * I;
+          geo = h2 * w.T[j] / w.l[j];
+          cd = w.T[j] > 0 ? ca : 0;
+          s = h2 * ka + h * cd - geo;
         } else {
-          const double rate = tj.dot(vk.col(j + 1) - vk.col(j)) / L0;  // [1/s] deps/dt
+          const double rate = t.col(j).dot(vk.col(j + 1) - vk.col(j)) / L0;  // [1/s] deps/dt
           const bool pushes = p_.EAc * (w.l[j] / L0 - 1) + ca * L0 * rate < 0;
-          c = pushes ? ca : 0;
-          B = (h2 * kc + h * c) * tj * tj.transpose();
+          cd = pushes ? ca : 0;
+          s = h2 * kc + h * cd;
+        }
+        double B[9];
+        for (int c = 0; c < 3; ++c) {
+          for (int r = 0; r < 3; ++r) B[r + 3 * c] = s * tj[r] * tj[c];
+        }
+        if (taut) {
+          for (int k = 0; k < 9; ++k) B[k] += geo * kI[k];
         }
         const bool d0 = Dynamic(j), d1 = Dynamic(j + 1);
         if (mixed && j + 1 == N_) {
           // The end segment of a mixed step, node j stepping h and end node B hN: B = h^2 K +
-          // h c t t^T, so K = (B - h c t t^T)/h^2; the blocks s_i s_j K + s_i c t t^T.
-          const Mat3 ct = c * tj * tj.transpose();
-          const Mat3 K = (B - h * ct) / h2;
-          if (d0) A.D(j - 1) += B;
+          // h c t t^T, so K = (B - h c t t^T)/h^2; the blocks s_i s_j K + s_i c t t^T (full
+          // blocks: Factor reads the lower triangle of the diagonal ones).
+          const Vec3 te = t.col(j);
+          const Mat3 Bm = Eigen::Map<const Mat3>(B);
+          const Mat3 ct = cd * te * te.transpose();
+          const Mat3 K = (Bm - h * ct) / h2;
+          if (d0) A.D(j - 1) += Bm;
           A.D(j) += hN * hN * K + hN * ct;
           if (d0) {
             A.L1(j) -= h * hN * K + h * ct;
-            end_t = tj;
-            end_c = (hN - h) * c;
+            end_t = te;
+            end_c = (hN - h) * cd;
           }
           continue;
         }
-        if (d0) A.D(j - 1) += B;
-        if (d1) A.D(j) += B;
-        if (d0 && d1) A.L1(j) -= B;
+        if (d0) {
+          double* d = A.D(j - 1).data();
+          for (int e = 0; e < 6; ++e) d[kLowK[e]] += B[kLowK[e]];
+        }
+        if (d1) {
+          double* d = A.D(j).data();
+          for (int e = 0; e < 6; ++e) d[kLowK[e]] += B[kLowK[e]];
+        }
+        if (d0 && d1) {
+          double* c = A.L1(j).data();
+          for (int k = 0; k < 9; ++k) c[k] -= B[k];
+        }
       }
     }
     // Bending: K = -EI/w g g^T I on the stencil of each curvature; B = h^2 EI/(w L0^2) g g^T I.
@@ -353,10 +397,18 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         const Vec3 vn = vr - vq * qi;
         const double vnn = vn.norm();
         const double ht = step(i) * li;
-        Mat3 J = (ht * (kt_ * 2 * std::abs(vq) - kn_ * vnn)) * qi * qi.transpose();
-        J.diagonal().array() += ht * kn_ * vnn;
-        if (vnn > 0) J += (ht * kn_ / vnn) * vn * vn.transpose();
-        A.D(i - 1) += J;
+        // J = s q q^T + ht kn |vn| I + (ht kn/|vn|) vn vn^T, lower triangle.
+        const double s = ht * (kt_ * 2 * std::abs(vq) - kn_ * vnn);
+        const double diag = ht * kn_ * vnn;
+        const double sn = vnn > 0 ? ht * kn_ / vnn : 0;
+        double* d = A.D(i - 1).data();
+        for (int e = 0; e < 6; ++e) {
+          const int r = kLowR[e], c = kLowC[e];
+          double J = s * qi[r] * qi[c];
+          if (r == c) J += diag;
+          if (vnn > 0) J += sn * vn[r] * vn[c];
+          d[kLowK[e]] += J;
+        }
       }
     }
     // Seabed: normal stiffness and damping, friction secant.
@@ -475,15 +527,29 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   // of the largest tension (or a microstrain), the step was too long for the linearisation.
   // (Without this, the fixed line at 160 segments and 50 ms steps went wrong by 3.6 kN RMS,
   // not 60 N.)
+  // The tension test without a square root: EA/L0 (|d| - t . d) <= bound is |d| <= r with
+  // r = t . d + bound L0/EA, that is r >= 0 and |d|^2 <= r^2 (|d| >= t . d always, so r < 0
+  // misses more than the bound). A NaN passes the tension test, as it passed the max() before
+  // (the divergence check reports it). One pass over the segments does both tests with one d.
   const double L0sq = L0_ * L0_;
   auto linearisation_held = [&]() {
+    const bool axial = Has(kAxial);
+    double T_max = 0;
+    if (axial) {
+      for (int j = 0; j < N_; ++j) T_max = std::max(T_max, w.T[j]);
+    }
+    const double bound = std::max(kLinearisationTolerance * T_max, 1e-6 * p_.EA);  // [N]
     for (int j = 0; j < N_; ++j) {
-      if (j == 0 && head_) {
-        const double r = WinchRest(next);
-        if (((xk.col(1) - xk.col(0)).squaredNorm() > r * r) != (w.l[0] > r)) return false;
-        continue;
+      const bool winch = j == 0 && head_;
+      const double L0 = winch ? WinchRest(next) : L0_;
+      const Vec3 d = xk.col(j + 1) - xk.col(j);
+      const double d2 = d.squaredNorm();
+      const bool taut = w.l[j] > L0;
+      if ((d2 > (winch ? L0 * L0 : L0sq)) != taut) return false;
+      if (axial && taut) {
+        const double r = t.col(j).dot(d) + bound * L0 / p_.EA;  // [m]
+        if (r < 0 || d2 > r * r) return false;
       }
-      if (((xk.col(j + 1) - xk.col(j)).squaredNorm() > L0sq) != (w.l[j] > L0_)) return false;
     }
     // Friction saturates over the slip speed eps: where the slip of a contact changed the
     // friction's tanh by more than 0.1 in the full Newton step just taken (rhs still holds it),
@@ -508,16 +574,7 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         }
       }
     }
-    if (!Has(kAxial)) return true;
-    double T_max = 0, missed = 0;
-    for (int j = 0; j < N_; ++j) {
-      T_max = std::max(T_max, w.T[j]);
-      const double L0 = j == 0 && head_ ? WinchRest(next) : L0_;
-      if (!(w.l[j] > L0)) continue;
-      const Vec3 d = xk.col(j + 1) - xk.col(j);
-      missed = std::max(missed, p_.EA / L0 * (d.norm() - t.col(j).dot(d)));
-    }
-    return missed <= std::max(kLinearisationTolerance * T_max, 1e-6 * p_.EA);
+    return true;
   };
 
   // First iteration: the linearly implicit step.
