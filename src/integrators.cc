@@ -225,6 +225,11 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   // The matrix M - h D - h^2 K at the iterate of the last residual, factored; the Newton
   // correction replaces the residual in rhs. False if the factorisation failed.
   bool newton = false;  // past the first iteration
+  // In those iterations, a segment that is slack at the iterate but that the last full Newton
+  // step left taut is predicted taut: see `extend` below.
+  const bool predict = Has(kAxial) && !Has(kCompression);
+  double* const predicted = w.taut;
+  std::fill(predicted, predicted + N_, 0.0);
   auto solve = [&]() {
     // The mass blocks are assigned, the coupling blocks zeroed: no pass over the whole band.
     A.SetZeroCoupling();
@@ -253,10 +258,26 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         const double kc = p_.EAc / L0;
         const double ca = Has(kDamping) ? p_.damping / L0 : 0;
         const bool taut = w.l[j] > L0;
-        if (!taut && !(compression && w.l[j] > 0 && w.l[j] < L0)) continue;
+        // A slack segment predicted taut (Newton iterations after the first, without a
+        // compression law) is linearised on the taut piece, extended below L0: the tension
+        // of the engaged, discrete law, (EA + damping/h) eps - (damping/h) eps+ at the start
+        // (negative here), joins the right-hand side and its stiffness the matrix, so that
+        // the Newton step lands where that piece puts the segment instead of overshooting
+        // L0 by the ratio of the stiffnesses (a primal-dual active-set step: Hintermueller,
+        // Ito & Kunisch, SIAM J. Optim. 13, 2003). G and the exit tests are unchanged, so
+        // is the step's solution; only the direction the iteration takes changes.
+        const bool extend = newton && predict && !taut && predicted[j] > 0 && w.l[j] > 0;
+        if (!taut && !extend && !(compression && w.l[j] > 0 && w.l[j] < L0)) continue;
         const Vec3 tj = t.col(j);
         Mat3 B;
-        if (taut) {
+        if (extend) {
+          const double eps_start = std::max(0.0, (x.col(j + 1) - x.col(j)).norm() / L0 - 1);
+          const double T_ext =
+              (p_.EA + ca * L0 / h) * (w.l[j] / L0 - 1) - ca * L0 / h * eps_start;  // [N]
+          if (Dynamic(j)) rhs.col(j - 1) += h * T_ext * tj;
+          if (Dynamic(j + 1)) rhs.col(j) -= h * T_ext * tj;
+          B = (h2 * ka + h * ca) * tj * tj.transpose();
+        } else if (taut) {
           // In the Newton iterations after the first, a taut segment whose damped tension is
           // clipped at zero (it shortens faster than EA eps/damping) is on the piece where
           // the law is 0: its Jacobian there is 0 (the first keeps the linearly implicit step's
@@ -430,15 +451,22 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   // (Without this, the fixed line at 160 segments and 50 ms steps went wrong by 3.6 kN RMS,
   // not 60 N.)
   const double L0sq = L0_ * L0_;
+  // A segment predicted taut (see `extend`) was linearised on the taut piece. Every segment's
+  // piece at the new iterate is recorded for the next iteration's prediction.
   auto linearisation_held = [&]() {
+    bool held = true;
     for (int j = 0; j < N_; ++j) {
-      if (j == 0 && head_) {
-        const double r = WinchRest(next);
-        if (((xk.col(1) - xk.col(0)).squaredNorm() > r * r) != (w.l[0] > r)) return false;
-        continue;
+      const double L0 = j == 0 && head_ ? WinchRest(next) : L0_;
+      const bool now_taut = (xk.col(j + 1) - xk.col(j)).squaredNorm() >
+                            (j == 0 && head_ ? L0 * L0 : L0sq);
+      const bool was_taut = w.l[j] > L0 || predicted[j] > 0;
+      if (newton && predict) predicted[j] = now_taut ? 1 : 0;
+      if (now_taut != was_taut) {
+        held = false;
+        if (!newton) break;
       }
-      if (((xk.col(j + 1) - xk.col(j)).squaredNorm() > L0sq) != (w.l[j] > L0_)) return false;
     }
+    if (!held) return false;
     // Friction saturates over the slip speed eps: where the slip of a contact changed the
     // friction's tanh by more than 0.1 in the full Newton step just taken (rhs still holds it),
     // the linearisation was not good for it (a tether starting to slide).
