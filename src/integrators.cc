@@ -264,8 +264,10 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         // (negative here), joins the right-hand side and its stiffness the matrix, so that
         // the Newton step lands where that piece puts the segment instead of overshooting
         // L0 by the ratio of the stiffnesses (a primal-dual active-set step: Hintermueller,
-        // Ito & Kunisch, SIAM J. Optim. 13, 2003). G and the exit tests are unchanged, so
-        // is the step's solution; only the direction the iteration takes changes.
+        // Ito & Kunisch, SIAM J. Optim. 13, 2003). G, the velocity tolerance and the line
+        // search are unchanged, and the piece test below compares with the piece the segment
+        // was linearised on: the steps' equations and tolerances are those of before, only
+        // the path the iteration takes to them changes.
         const bool extend = newton && predict && !taut && predicted[j] > 0 && w.l[j] > 0;
         if (!taut && !extend && !(compression && w.l[j] > 0 && w.l[j] < L0)) continue;
         const Vec3 tj = t.col(j);
@@ -452,14 +454,16 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   // not 60 N.)
   const double L0sq = L0_ * L0_;
   // A segment predicted taut (see `extend`) was linearised on the taut piece. Every segment's
-  // piece at the new iterate is recorded for the next iteration's prediction.
+  // piece at the new iterate is recorded for the next iteration's prediction (where the test
+  // passes, that is the piece each segment was linearised on, which the turning test below
+  // reads).
   auto linearisation_held = [&]() {
     bool held = true;
     for (int j = 0; j < N_; ++j) {
       const double L0 = j == 0 && head_ ? WinchRest(next) : L0_;
       const bool now_taut = (xk.col(j + 1) - xk.col(j)).squaredNorm() >
                             (j == 0 && head_ ? L0 * L0 : L0sq);
-      const bool was_taut = w.l[j] > L0 || predicted[j] > 0;
+      const bool was_taut = w.l[j] > L0 || (predicted[j] > 0 && w.l[j] > 0);
       if (newton && predict) predicted[j] = now_taut ? 1 : 0;
       if (now_taut != was_taut) {
         held = false;
@@ -495,7 +499,7 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
     for (int j = 0; j < N_; ++j) {
       T_max = std::max(T_max, w.T[j]);
       const double L0 = j == 0 && head_ ? WinchRest(next) : L0_;
-      if (!(w.l[j] > L0)) continue;
+      if (!(w.l[j] > L0) && !(predicted[j] > 0)) continue;
       const Vec3 d = xk.col(j + 1) - xk.col(j);
       missed = std::max(missed, p_.EA / L0 * (d.norm() - t.col(j).dot(d)));
     }
