@@ -461,8 +461,8 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
     bool held = true;
     for (int j = 0; j < N_; ++j) {
       const double L0 = j == 0 && head_ ? WinchRest(next) : L0_;
-      const bool now_taut = (xk.col(j + 1) - xk.col(j)).squaredNorm() >
-                            (j == 0 && head_ ? L0 * L0 : L0sq);
+      const bool now_taut =
+          (xk.col(j + 1) - xk.col(j)).squaredNorm() > (j == 0 && head_ ? L0 * L0 : L0sq);
       const bool was_taut = w.l[j] > L0 || (predicted[j] > 0 && w.l[j] > 0);
       if (newton && predict) predicted[j] = now_taut ? 1 : 0;
       if (now_taut != was_taut) {

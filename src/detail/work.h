@@ -60,8 +60,8 @@ struct Work {
   double* taut;  // N       implicit: 1 where the last full Newton step left the segment taut
   static int Size(int N) {
     const int n = N + 1;
-    return 3 * n + 3 * N + N + N + 3 * n + 3 * n + 3 * n + 3 * n + 3 * n +
-           BlockBand::Size(n) + 18 * n + N;
+    return 3 * n + 3 * N + N + N + 3 * n + 3 * n + 3 * n + 3 * n + 3 * n + BlockBand::Size(n) +
+           18 * n + N;
   }
   Work(double* w, int N) {
     const int n = N + 1;
