@@ -242,6 +242,12 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   // The matrix M - h D - h^2 K at the iterate of the last residual, factored; the Newton
   // correction replaces the residual in rhs. False if the factorisation failed.
   bool newton = false;  // past the first iteration
+  // In those iterations, a segment that is slack at the iterate but that the last full Newton
+  // step left taut is predicted taut: see `extend` below.
+  // (Not on a mixed step, whose damping is not in the discrete form the prediction uses.)
+  const bool predict = Has(kAxial) && !Has(kCompression) && !mixed;
+  double* const predicted = w.taut;
+  std::fill(predicted, predicted + N_, 0.0);
   auto solve = [&]() {
     // The mass blocks are assigned, the coupling blocks zeroed: no pass over the whole band.
     // The diagonal blocks are symmetric and Factor reads their lower triangle only: the mass,
@@ -291,13 +297,32 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         const double kc = winch ? p_.EAc / L0 : kc0;
         const double ca = !Has(kDamping) ? 0 : winch ? p_.damping / L0 : ca0;
         const bool taut = w.l[j] > L0;
-        if (!taut && !(compression && w.l[j] > 0 && w.l[j] < L0)) continue;
+        // A slack segment predicted taut (Newton iterations after the first, without a
+        // compression law) is linearised on the taut piece, extended below L0: the tension
+        // of the engaged, discrete law, (EA + damping/h) eps - (damping/h) eps+ at the start
+        // (negative here), joins the right-hand side and its stiffness the matrix, so that
+        // the Newton step lands where that piece puts the segment instead of overshooting
+        // L0 by the ratio of the stiffnesses (a primal-dual active-set step: Hintermueller,
+        // Ito & Kunisch, SIAM J. Optim. 13, 2003). G, the velocity tolerance and the line
+        // search are unchanged, and the piece test below compares with the piece the segment
+        // was linearised on: the steps' equations and tolerances are those of before, only
+        // the path the iteration takes to them changes.
+        const bool extend = newton && predict && !taut && predicted[j] > 0 && w.l[j] > 0;
+        if (!taut && !extend && !(compression && w.l[j] > 0 && w.l[j] < L0)) continue;
         const double* tj = w.t + 3 * j;
         // B = s t t^T + geo I; full (the coupling block is not symmetric to the bit: the
         // products (s t_r) t_c and (s t_c) t_r may round apart).
         double s, geo = 0;
         double cd = 0;  // [kg/s] the damping along t in B (for the mixed step's end segment)
-        if (taut) {
+        if (extend) {
+          const double eps_start = std::max(0.0, (x.col(j + 1) - x.col(j)).norm() / L0 - 1);
+          const double T_ext =
+              (p_.EA + ca * L0 / h) * (w.l[j] / L0 - 1) - ca * L0 / h * eps_start;  // [N]
+          if (Dynamic(j)) rhs.col(j - 1) += h * T_ext * t.col(j);
+          if (Dynamic(j + 1)) rhs.col(j) -= h * T_ext * t.col(j);
+          cd = ca;
+          s = h2 * ka + h * ca;
+        } else if (taut) {
           // In the Newton iterations after the first, a taut segment whose damped tension is
           // clipped at zero (it shortens faster than EA eps/damping) is on the piece where
           // the law is 0: its Jacobian there is 0 (the first keeps the linearly implicit step's
@@ -532,6 +557,10 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   // misses more than the bound). A NaN passes the tension test, as it passed the max() before
   // (the divergence check reports it). One pass over the segments does both tests with one d.
   const double L0sq = L0_ * L0_;
+  // A segment predicted taut (see `extend`) was linearised on the taut piece. Every segment's
+  // piece at the new iterate is recorded for the next iteration's prediction (where the test
+  // passes, that is the piece each segment was linearised on, which the turning test below
+  // reads).
   auto linearisation_held = [&]() {
     const bool axial = Has(kAxial);
     double T_max = 0;
@@ -539,18 +568,27 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
       for (int j = 0; j < N_; ++j) T_max = std::max(T_max, w.T[j]);
     }
     const double bound = std::max(kLinearisationTolerance * T_max, 1e-6 * p_.EA);  // [N]
+    bool held = true;
     for (int j = 0; j < N_; ++j) {
       const bool winch = j == 0 && head_;
       const double L0 = winch ? WinchRest(next) : L0_;
       const Vec3 d = xk.col(j + 1) - xk.col(j);
       const double d2 = d.squaredNorm();
-      const bool taut = w.l[j] > L0;
-      if ((d2 > (winch ? L0 * L0 : L0sq)) != taut) return false;
-      if (axial && taut) {
+      const bool now_taut = d2 > (winch ? L0 * L0 : L0sq);
+      // Linearised on the taut piece: taut at the iterate, or predicted taut (`extend`).
+      const bool was_taut = w.l[j] > L0 || (predicted[j] > 0 && w.l[j] > 0);
+      if (newton && predict) predicted[j] = now_taut ? 1 : 0;
+      bool ok = now_taut == was_taut;
+      if (ok && axial && was_taut) {
         const double r = t.col(j).dot(d) + bound * L0 / p_.EA;  // [m]
-        if (r < 0 || d2 > r * r) return false;
+        ok = r >= 0 && d2 <= r * r;
+      }
+      if (!ok) {
+        held = false;
+        if (!newton || !predict) break;  // (the prediction needs every segment's piece)
       }
     }
+    if (!held) return false;
     // Friction saturates over the slip speed eps: where the slip of a contact changed the
     // friction's tanh by more than 0.1 in the full Newton step just taken (rhs still holds it),
     // the linearisation was not good for it (a tether starting to slide).

@@ -57,10 +57,11 @@ struct Work {
   double* v0;    // 3 x n
   double* dv;    // 3 x n   implicit Newton correction (line search)
   double* vb;    // 3 x n   implicit iterate the line search starts from
+  double* taut;  // N       implicit: 1 where the last full Newton step left the segment taut
   static int Size(int N) {
     const int n = N + 1;
-    return 3 * n + 3 * N + N + N + 3 * n + 3 * n + 3 * n + 3 * n + 3 * n +
-           BlockBand::Size(n) + 18 * n;
+    return 3 * n + 3 * N + N + N + 3 * n + 3 * n + 3 * n + 3 * n + 3 * n + BlockBand::Size(n) +
+           18 * n + N;
   }
   Work(double* w, int N) {
     const int n = N + 1;
@@ -80,6 +81,7 @@ struct Work {
     v0 = x0 + 3 * n;
     dv = v0 + 3 * n;
     vb = dv + 3 * n;
+    taut = vb + 3 * n;
   }
 };
 
