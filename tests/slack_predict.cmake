@@ -2,4 +2,4 @@
 # "Predicted pieces in the Newton iteration"). Cost figures: tests/bench/bench_slack.
 add_executable(slack_predict_test slack_predict_test.cc)
 target_link_libraries(slack_predict_test PRIVATE mjtether_core GTest::gtest_main)
-gtest_discover_tests(slack_predict_test DISCOVERY_TIMEOUT 60)
+gtest_discover_tests(slack_predict_test NO_PRETTY_VALUES DISCOVERY_TIMEOUT 60)
