@@ -10,13 +10,11 @@
 #include <vector>
 
 #include "make_tether.h"
-#include "tether.h"
 #include "slack_scene.h"
+#include "tether.h"
 
 namespace mjtether {
 namespace {
-
-
 
 // 152 segments of 5 cm, dry, no gravity, damping 200 N s (damping time m L0/damping = 4 us
 // against the 2 ms step): segments hover at L0 and many change between slack and taut in every
@@ -27,31 +25,12 @@ namespace {
 // twenty times below the old behaviour. No step may be accepted unconverged (stalled), and the
 // run must stay finite and within max_strain (Advance's own checks).
 TEST(SlackLineSearch, HeavilyDampedSlackTetherSettlesWithoutHalving) {
-  TetherParams p;
-  p.length = 7.6;
-  p.segments = 152;
-  p.diameter = 0.02;
-  p.mass_per_length = 0.32201;
-  p.EA = 2e5;
-  p.EI = 0.05;
-  p.damping = 200;
-  p.integrator = Integrator::kImplicit;
   Environment env;
   env.gravity = Vec3::Zero();
-  const Tether t = Make(p, env);
-  const double h = 0.002;
   const int steps = 5000;
-  std::vector<double> x(3 * t.nodes()), v(3 * t.nodes()), work(t.WorkspaceSize());
-  t.InitialShape(Circling(0), x.data(), v.data());
-  long retried = 0, stalled = 0, newton = 0;
-  for (int k = 0; k < steps; ++k) {
-    const StepStatus s =
-        t.Advance(x.data(), v.data(), Circling(k * h), Circling((k + 1) * h), h, work.data());
-    ASSERT_TRUE(s.ok) << s.reason << " at step " << k;
-    retried += s.halvings > 0;
-    stalled += s.stalled_steps;
-    newton += s.newton_iterations;
-  }
+  const SlackCounts c = RunCircling(Make(DampedSlackParams(200), env), 0.002, steps);
+  ASSERT_TRUE(c.failure.empty()) << c.failure;
+  const long retried = c.retried, stalled = c.stalled, newton = c.newton;
   std::printf("damping 200: %.2f%% of the steps retried in halves, %.2f solves per step\n",
               100.0 * retried / steps, static_cast<double>(newton) / steps);
   EXPECT_LE(retried, steps / 50);

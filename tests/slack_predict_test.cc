@@ -24,38 +24,20 @@ namespace {
 // elsewhere in the law. The steps must also not be bought with halvings or stalls: at most 1%
 // of the steps retried in halves (measured 0.10%; 0.16% before), none stalled.
 TEST(SlackPredict, HeavilyDampedSlackTetherInWaterTakesFewerSolves) {
-  TetherParams p;
-  p.length = 7.6;
-  p.segments = 152;
-  p.diameter = 0.02;
-  p.mass_per_length = 0.32201;
-  p.EA = 2e5;
-  p.EI = 0.05;
+  TetherParams p = DampedSlackParams(200);
   p.Cdn = 1.2;
   p.Cdt = 0.01;
   p.Can = 1;
-  p.damping = 200;
-  p.integrator = Integrator::kImplicit;
   Environment env;
   env.wet = true;
   DeclarationError e;
   const std::optional<Water> water = ParseWater("density=1025 current=0,0.3,0", &e);
   ASSERT_TRUE(water) << e.message;
   env.water = *water;
-  const Tether t = Make(p, env);
-  const double h = 0.002;
   const int steps = 5000;
-  std::vector<double> x(3 * t.nodes()), v(3 * t.nodes()), work(t.WorkspaceSize());
-  t.InitialShape(Circling(0), x.data(), v.data());
-  long retried = 0, stalled = 0, newton = 0;
-  for (int k = 0; k < steps; ++k) {
-    const StepStatus s =
-        t.Advance(x.data(), v.data(), Circling(k * h), Circling((k + 1) * h), h, work.data());
-    ASSERT_TRUE(s.ok) << s.reason << " at step " << k;
-    retried += s.halvings > 0;
-    stalled += s.stalled_steps;
-    newton += s.newton_iterations;
-  }
+  const SlackCounts c = RunCircling(Make(p, env), 0.002, steps);
+  ASSERT_TRUE(c.failure.empty()) << c.failure;
+  const long retried = c.retried, stalled = c.stalled, newton = c.newton;
   const double solves = static_cast<double>(newton) / steps;
   std::printf("water, damping 200: %.3f solves per step, %.2f%% of the steps retried\n", solves,
               100.0 * retried / steps);
