@@ -211,6 +211,22 @@ inline std::string Declaration(const Scene& s, int N, const std::string& integra
   return d.str();
 }
 
+// The fixed comparison line as an MJCF model at MuJoCo step h [s]: end A anchored at
+// (0, 0, -150), end B on the mocap body `fairlead` (move it along s.b). Used by bench_callback
+// and tools/line_steps.cc.
+inline std::string LineModelXml(const Scene& s, int segments, const char* integrator, double h) {
+  std::ostringstream x;
+  x.precision(17);
+  x << "<mujoco><option timestep=\"" << h << "\"/><custom>"
+    << "<text name=\"water\" data=\"" << s.water << "\"/>"
+    << "<text name=\"tether:line\" data=\"ends=anchor,fair "
+    << Declaration(s, segments, integrator, 0, 0) << "\"/></custom><worldbody>"
+    << "<site name=\"anchor\" pos=\"0 0 -150\"/>"
+    << "<body name=\"fairlead\" mocap=\"true\" pos=\"80 0 -100\"><site name=\"fair\"/></body>"
+    << "</worldbody></mujoco>";
+  return x.str();
+}
+
 inline std::optional<Tether> MakeTether(const Scene& s, int N, const std::string& integrator,
                                  double max_step, int substeps, std::string* error) {
   Environment env;

@@ -25,17 +25,9 @@ int main(int argc, char** argv) {
   const int warm = argc > 4 ? atoi(argv[4]) : 5000;
   const rs::Scene s = rs::LineScene();
   const double h = 0.002;
-  std::ostringstream x;
-  x.precision(17);
-  x << "<mujoco><option timestep=\"" << h << "\"/><custom>"
-    << "<text name=\"water\" data=\"" << s.water << "\"/>"
-    << "<text name=\"tether:line\" data=\"ends=anchor,fair "
-    << rs::Declaration(s, segments, integrator, 0, 0) << "\"/></custom><worldbody>"
-    << "<site name=\"anchor\" pos=\"0 0 -150\"/>"
-    << "<body name=\"fairlead\" mocap=\"true\" pos=\"80 0 -100\"><site name=\"fair\"/></body>"
-    << "</worldbody></mujoco>";
   std::string error;
-  mjModel* m = mjtether::LoadModelFromString(x.str(), "line.xml", &error);
+  mjModel* m = mjtether::LoadModelFromString(rs::LineModelXml(s, segments, integrator, h),
+                                             "line.xml", &error);
   if (!m) { fprintf(stderr, "%s\n", error.c_str()); return 1; }
   mjData* d = mj_makeData(m);
   auto step = [&]() {

@@ -94,17 +94,9 @@ void Line(benchmark::State& state, const char* integrator) {
   const int segments = static_cast<int>(state.range(0));
   const rs::Scene s = rs::LineScene();
   const double h = 0.002;  // [s]
-  std::ostringstream x;
-  x.precision(17);
-  x << "<mujoco><option timestep=\"" << h << "\"/><custom>"
-    << "<text name=\"water\" data=\"" << s.water << "\"/>"
-    << "<text name=\"tether:line\" data=\"ends=anchor,fair "
-    << rs::Declaration(s, segments, integrator, 0, 0) << "\"/></custom><worldbody>"
-    << "<site name=\"anchor\" pos=\"0 0 -150\"/>"
-    << "<body name=\"fairlead\" mocap=\"true\" pos=\"80 0 -100\"><site name=\"fair\"/></body>"
-    << "</worldbody></mujoco>";
   std::string error;
-  mjModel* m = mjtether::LoadModelFromString(x.str(), "line.xml", &error);
+  mjModel* m = mjtether::LoadModelFromString(rs::LineModelXml(s, segments, integrator, h),
+                                             "line.xml", &error);
   if (!m) {
     state.SkipWithError(error.c_str());
     return;
