@@ -17,11 +17,19 @@ with the reason) are run too; they are expected to survive and are left out of t
     score = caught / (caught + survived), over the non-equivalent entries.
 
 The working tree is never written to: only the scratch directory (default
-$TMPDIR/mjtether-mutation) is.
+$TMPDIR/mjtether-mutation) is. The exception is --in-place, for a disposable clone whose build
+directory is already built (.ci/run): each mutant is planted in the repository's own file and
+built in that build directory (no second full build), and the file is restored afterwards,
+whatever happens; files with uncommitted changes are refused.
+
+An entry may name `first`, a ctest regex of the tests known to catch it: they run first, and
+the whole fast suite runs only if they all pass (a mutant is still "caught" only by a failing
+test). This keeps a sample run to a rebuild and a test or two per entry.
 
 Usage:
   tools/mutate.py                 # the whole catalogue (about 1-2 min per entry on 2 cores)
-  tools/mutate.py --sample        # the entries marked `sample = yes` (CI: .ci/run)
+  tools/mutate.py --sample        # the entries marked `sample = yes`
+  tools/mutate.py --sample --in-place --no-baseline   # what .ci/run does, in its clone's build/
   tools/mutate.py --only ID,ID    # some entries
   tools/mutate.py --list          # list the entries and check their patterns, build nothing
   tools/mutate.py --report docs/mutation_results.md   # also write the table as Markdown
@@ -34,6 +42,7 @@ import configparser
 import os
 import pathlib
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -79,6 +88,7 @@ def load_catalogue(path):
         "breaks": " ".join(s["breaks"].split()),
         "sample": s.get("sample", "no").strip() == "yes",
         "equivalent": " ".join(s.get("equivalent", "").split()),
+        "first": s.get("first", "").strip(),
     })
   return entries
 
@@ -139,13 +149,15 @@ def build_tree(build, jobs, log):
   return status == 0, out
 
 
-def run_suite(build, jobs, log, first_only):
+def run_suite(build, jobs, log, first_only, regex=None):
   """Runs the fast suite; returns the names of the tests that failed (empty: all passed).
   With first_only, ctest stops starting tests after the first failure (tests that failed in the
   previous run go first, so a mutant like the last one is caught in seconds)."""
   failed_log = build / "Testing" / "Temporary" / "LastTestsFailed.log"
   cmd = ["ctest", "--test-dir", build, f"-j{jobs}", "-LE", FAST_EXCLUDE_LABELS, "-E",
          FAST_EXCLUDE_NAMES, "--timeout", str(TEST_TIMEOUT)]
+  if regex:
+    cmd += ["-R", regex]
   if first_only:
     cmd.append("--stop-on-failure")
   status, out = run(cmd, log=log)
@@ -157,6 +169,8 @@ def run_suite(build, jobs, log, first_only):
       failed.append(line.split(":", 1)[1] if ":" in line else line)
   if status != 0 and not failed:
     failed = ["(ctest failed without a failing test: see the log)"]
+  if status == 0 and regex and "No tests were found" in out:
+    failed = []  # a stale `first` regex: the whole suite decides (the log says so)
   return failed
 
 
@@ -181,7 +195,18 @@ def main():
                   help="run the whole fast suite on each mutant and list every test that "
                        "catches it (default: stop at the first failing test)")
   ap.add_argument("--report", help="also write the results as a Markdown table to this file")
+  ap.add_argument("--in-place", action="store_true",
+                  help="plant each mutant in the repository itself and build in --build "
+                       "(for a disposable clone; refuses files with uncommitted changes)")
+  ap.add_argument("--build", default=str(REPO / "build"),
+                  help="with --in-place: the configured build directory (default: build/)")
+  ap.add_argument("--no-baseline", action="store_true",
+                  help="build the unmutated tree but do not run its suite (when the caller "
+                       "has just run it, as .ci/run has)")
   args = ap.parse_args()
+  # A SIGTERM (a CI time-out, kill) unwinds like an exception, so that the `finally` below
+  # restores a mutated file (in place: the repository's own).
+  signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
 
   entries = load_catalogue(args.catalogue)
   ids = [e["id"] for e in entries]
@@ -216,20 +241,36 @@ def main():
     return 2
   scratch.mkdir(parents=True, exist_ok=True)
   log = open(scratch / "mutate.log", "w")
-  print(f"scratch tree and build: {scratch} (log: {scratch / 'mutate.log'})", flush=True)
-  tree = sync_tree(scratch)
-  build = scratch / "build"
-  configure(tree, build, log)
+  if args.in_place:
+    tree, build = REPO, pathlib.Path(args.build).resolve()
+    if not (build / "CMakeCache.txt").exists():
+      print(f"--in-place: {build} is not a configured build directory", file=sys.stderr)
+      return 2
+    dirty = subprocess.run(["git", "status", "--porcelain", "--"] +
+                           sorted({e["file"] for e in entries}), cwd=REPO,
+                           stdout=subprocess.PIPE, text=True, check=True).stdout.strip()
+    if dirty:
+      print(f"--in-place: these files have uncommitted changes, which a mutant would "
+            f"overwrite:\n{dirty}", file=sys.stderr)
+      return 2
+    print(f"in place: {REPO}, build {build} (log: {scratch / 'mutate.log'})", flush=True)
+  else:
+    print(f"scratch tree and build: {scratch} (log: {scratch / 'mutate.log'})", flush=True)
+    tree = sync_tree(scratch)
+    build = scratch / "build"
+    configure(tree, build, log)
   t0 = time.time()
   ok, out = build_tree(build, args.jobs, log)
   if not ok:
     print(f"the unmutated tree does not build:\n{out[-3000:]}", file=sys.stderr)
     return 2
-  failed = run_suite(build, args.jobs, log, False)
-  if failed:
-    print(f"the unmutated suite fails: {', '.join(failed)}", file=sys.stderr)
-    return 2
-  print(f"baseline: builds and passes ({time.time() - t0:.0f} s)", flush=True)
+  if not args.no_baseline:
+    failed = run_suite(build, args.jobs, log, False)
+    if failed:
+      print(f"the unmutated suite fails: {', '.join(failed)}", file=sys.stderr)
+      return 2
+  print(f"baseline: builds{'' if args.no_baseline else ' and passes'} "
+        f"({time.time() - t0:.0f} s)", flush=True)
 
   results = []
   for k, e in enumerate(entries, 1):
@@ -248,7 +289,11 @@ def main():
         if not built:
           r = {"status": "error", "detail": "the mutant does not compile"}
         else:
-          failed = run_suite(build, args.jobs, log, not args.all_tests)
+          failed = []
+          if e["first"] and not args.all_tests:
+            failed = run_suite(build, args.jobs, log, True, e["first"])
+          if not failed:
+            failed = run_suite(build, args.jobs, log, not args.all_tests)
           if failed:
             r = {"status": "caught", "detail": ", ".join(failed)}
           else:
@@ -263,7 +308,13 @@ def main():
     print(f"[{k}/{len(entries)}] {e['id']}: {shown} in {r['seconds']:.0f} s  {detail}",
           flush=True)
 
-  # Leave the scratch build matching the repository again (the last file was restored).
+  # Leave the build matching the repository again (the last file was restored): in place, the
+  # caller's build directory must not keep a mutant's objects.
+  if args.in_place:
+    ok, out = build_tree(build, args.jobs, log)
+    if not ok:
+      print(f"rebuilding the restored tree failed:\n{out[-3000:]}", file=sys.stderr)
+      return 2
   scored = [r for r in results if not r["equivalent"] and r["status"] != "error"]
   caught = sum(r["status"] == "caught" for r in scored)
   survived = [r for r in scored if r["status"] == "survived"]
