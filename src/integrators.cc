@@ -310,9 +310,8 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         // tension is clipped at zero (it is on the law's zero piece, below the kink l* of the
         // piece test) but predicted on the positive piece (not the winch segment, whose rest
         // length changes within the step).
-        const bool clipped = taut && !(w.T[j] > 0) && !winch;
-        const bool extend =
-            newton && predict && (!taut || clipped) && predicted[j] > 0 && w.l[j] > 0;
+        const bool extend = newton && predict && predicted[j] > 0 &&
+                            (!taut || (!winch && !(w.T[j] > 0))) && w.l[j] > 0;
         if (!taut && !extend && !(compression && w.l[j] > 0 && w.l[j] < L0)) continue;
         const double* tj = w.t + 3 * j;
         // B = s t t^T + geo I; full (the coupling block is not symmetric to the bit: the
@@ -576,11 +575,11 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   // the test of L0 would fail a segment crossing L0 within the zero piece (no tension missed),
   // this one does not; where it would pass a clipped segment moved beyond l* (its tension
   // missed) or a predicted one left between L0 and l* (a compression the law does not have),
-  // this one fails it. Without damping l* = L0 and w.T > 0 means l > L0: the same test.
+  // this one fails it. Without damping l* = L0 and w.T > 0 means l > L0: the test of L0.
   const double kink = Has(kDamping) ? (p_.damping / h) / (p_.EA + p_.damping / h) : 0;  // [-]
   auto linearisation_held = [&]() {
     const bool axial = Has(kAxial);
-    const bool pieces = newton && predict;
+    const bool pieces = newton && predict && kink > 0;  // (kink 0: the test of L0 below)
     double T_max = 0;
     if (axial) {
       for (int j = 0; j < N_; ++j) T_max = std::max(T_max, w.T[j]);
@@ -592,16 +591,17 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
       const double L0 = winch ? WinchRest(next) : L0_;
       const Vec3 d = xk.col(j + 1) - xk.col(j);
       const double d2 = d.squaredNorm();
-      bool now_taut = d2 > (winch ? L0 * L0 : L0sq);
-      // Linearised on the taut piece: taut at the iterate, or predicted taut (`extend`).
-      bool was_taut = w.l[j] > L0 || (predicted[j] > 0 && w.l[j] > 0);
-      if (pieces && !winch) {
-        // The positive piece of the discrete law, beyond l* (see above).
+      // Linearised on the taut piece: taut at the iterate (positive, with the kink), or
+      // predicted taut (`extend`); now beyond L0 (l* with the kink, see above).
+      const bool kinked = pieces && !winch;
+      double edge2 = winch ? L0 * L0 : L0sq;  // [m^2]
+      if (kinked) {
         const double ls = (x.col(j + 1) - x.col(j)).norm();  // [m] at the start of the step
-        const double lstar = ls > L0_ ? L0_ + kink * (ls - L0_) : L0_;
-        now_taut = d2 > lstar * lstar;
-        was_taut = w.T[j] > 0 || (predicted[j] > 0 && w.l[j] > 0);
+        if (ls > L0_) edge2 = (L0_ + kink * (ls - L0_)) * (L0_ + kink * (ls - L0_));
       }
+      const bool now_taut = d2 > edge2;
+      const bool was_taut =
+          (kinked ? w.T[j] > 0 : w.l[j] > L0) || (predicted[j] > 0 && w.l[j] > 0);
       if (newton && predict) predicted[j] = now_taut ? 1 : 0;
       bool ok = now_taut == was_taut;
       if (ok && axial && was_taut) {
