@@ -306,8 +306,12 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         // Ito & Kunisch, SIAM J. Optim. 13, 2003). G, the velocity tolerance and the line
         // search are unchanged, and the piece test below compares with the piece the segment
         // was linearised on: the steps' equations and tolerances are those of before, only
-        // the path the iteration takes to them changes.
-        const bool extend = newton && predict && !taut && predicted[j] > 0 && w.l[j] > 0;
+        // the path the iteration takes to them changes. Likewise a taut segment whose damped
+        // tension is clipped at zero (it is on the law's zero piece, below the kink l* of the
+        // piece test) but predicted on the positive piece (not the winch segment, whose rest
+        // length changes within the step).
+        const bool extend = newton && predict && predicted[j] > 0 &&
+                            (!taut || (!winch && !(w.T[j] > 0))) && w.l[j] > 0;
         if (!taut && !extend && !(compression && w.l[j] > 0 && w.l[j] < L0)) continue;
         const double* tj = w.t + 3 * j;
         // B = s t t^T + geo I; full (the coupling block is not symmetric to the bit: the
@@ -561,8 +565,21 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   // piece at the new iterate is recorded for the next iteration's prediction (where the test
   // passes, that is the piece each segment was linearised on, which the turning test below
   // reads).
+  // In the Newton iterations with the prediction, the pieces are those of the discrete damped
+  // law, T = max(0, (EA + c/h) (l - L0)/L0 - (c/h) eps+(start)) for l > L0 and 0 below: a
+  // segment taut at the start of the step (length ls > L0) has its kink not at L0 but at
+  // l* = L0 + c/h / (EA + c/h) (ls - L0) (for c = 200 N s, EA = 2e5 N, h = 2 ms a third of the
+  // way from L0 to ls), the tension being 0 on both sides of L0 below it. The test compares
+  // the side of l* (the positive piece or the zero piece) with the piece the segment was
+  // linearised on: positive (w.T > 0 at the iterate) or predicted positive (`extend`). Where
+  // the test of L0 would fail a segment crossing L0 within the zero piece (no tension missed),
+  // this one does not; where it would pass a clipped segment moved beyond l* (its tension
+  // missed) or a predicted one left between L0 and l* (a compression the law does not have),
+  // this one fails it. Without damping l* = L0 and w.T > 0 means l > L0: the test of L0.
+  const double kink = Has(kDamping) ? (p_.damping / h) / (p_.EA + p_.damping / h) : 0;  // [-]
   auto linearisation_held = [&]() {
     const bool axial = Has(kAxial);
+    const bool pieces = newton && predict && kink > 0;  // (kink 0: the test of L0 below)
     double T_max = 0;
     if (axial) {
       for (int j = 0; j < N_; ++j) T_max = std::max(T_max, w.T[j]);
@@ -574,9 +591,17 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
       const double L0 = winch ? WinchRest(next) : L0_;
       const Vec3 d = xk.col(j + 1) - xk.col(j);
       const double d2 = d.squaredNorm();
-      const bool now_taut = d2 > (winch ? L0 * L0 : L0sq);
-      // Linearised on the taut piece: taut at the iterate, or predicted taut (`extend`).
-      const bool was_taut = w.l[j] > L0 || (predicted[j] > 0 && w.l[j] > 0);
+      // Linearised on the taut piece: taut at the iterate (positive, with the kink), or
+      // predicted taut (`extend`); now beyond L0 (l* with the kink, see above).
+      const bool kinked = pieces && !winch;
+      double edge2 = winch ? L0 * L0 : L0sq;  // [m^2]
+      if (kinked) {
+        const double ls = (x.col(j + 1) - x.col(j)).norm();  // [m] at the start of the step
+        if (ls > L0_) edge2 = (L0_ + kink * (ls - L0_)) * (L0_ + kink * (ls - L0_));
+      }
+      const bool now_taut = d2 > edge2;
+      const bool was_taut =
+          (kinked ? w.T[j] > 0 : w.l[j] > L0) || (predicted[j] > 0 && w.l[j] > 0);
       if (newton && predict) predicted[j] = now_taut ? 1 : 0;
       bool ok = now_taut == was_taut;
       if (ok && axial && was_taut) {
@@ -640,6 +665,20 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   for (int j = 0; j < N_; ++j) T_max = std::max(T_max, w.T[j]);
   const double tolerance =
       kNewtonTolerance * std::sqrt(dv_max) + 1e-12 * h * (2 * T_max + W_max) / m_min;
+  // The first iteration's taut set carried into the Newton iterations (with damping): every
+  // segment that it linearised on the taut piece (w.l still holds the first iterate's lengths)
+  // is predicted on the positive piece of the discrete law. Such segments, taut at the start
+  // of the step and near L0, were the most frequent piece changes: the first iteration's full
+  // step (with the instantaneous damping rate t . dv/L0) took them below l*, and from the zero
+  // piece, whose Jacobian is nothing, the next full step overshot l* again, one more solve to
+  // learn what the first iteration had (dry, zero g, damping 200: 3.84 solves per step with
+  // the set learned from full Newton steps only, 1.92 with this; docs/numerics_slack.md).
+  if (predict && Has(kDamping)) {
+    for (int j = 0; j < N_; ++j) {
+      const double L0 = j == 0 && head_ ? WinchRest(next) : L0_;
+      predicted[j] = w.l[j] > L0 ? 1 : 0;
+    }
+  }
   // Not on a mixed step: the end segment's backward difference of the strain would need a
   // common start, which its two nodes (stepping he from x-hat and h from x) do not have; the
   // damping stays on the node velocities there, as in the first iteration.
