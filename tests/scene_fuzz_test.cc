@@ -21,8 +21,10 @@
 //                0.2 s within max(0.5 N, 5%) (the criterion for "silently wrong");
 //                where they disagree, against the scene at 0.02 ms within that tolerance
 //                plus the spread of the two refinements (0.2 vs 0.02 ms: the reference's
-//                own uncertainty, e.g. a mean over snaps); and, without a current, the tether's energy never rises above its start by
-//                more than the work its ends did on it (EnergyTolerance, below);
+//                own uncertainty, e.g. a mean over snaps); and, without a current, the
+//                tether's energy never rises above its start by more than the work its ends
+//                did on it (EnergyTolerance, below). A stretched start that disagrees is
+//                judged again started unstretched, for the failure's class only;
 //   diverged     stops with a divergence message whose cause this file checks: thrust beyond
 //                EA x max_strain, ends pulled beyond length x (1 + max_strain), an end moving
 //                more than half of max_strain L0 per step, an end below the seabed, a stretched
@@ -318,7 +320,9 @@ Run Simulate(const Scene& s, double step, double duration = -1) {
   mjModel* m = LoadModelFromString(xml, "scene" + std::to_string(s.seed) + ".xml", &run.error);
   if (!m) return run;
   run.loaded = true;
-  for (const std::string& w : Warnings(m)) run.stretched = run.stretched || Contains(w, "starts stretched");
+  for (const std::string& w : Warnings(m)) {
+    run.stretched = run.stretched || Contains(w, "starts stretched");
+  }
   mjData* d = mj_makeData(m);
   t_warnings = 0;
   run.duration = duration > 0 ? duration : Duration(m);
@@ -447,7 +451,12 @@ Scene Unstretched(const Scene& s) {
   to.precision(10);
   from << " length=" << s.length << " ";
   to << " length=" << u.length << " ";
-  u.xml.replace(u.xml.find(from.str()), from.str().size(), to.str());
+  const size_t at = u.xml.find(from.str());
+  if (at == std::string::npos) {
+    u.xml.clear();  // not found: the caller's run does not load, and nothing is concluded
+  } else {
+    u.xml.replace(at, from.str().size(), to.str());
+  }
   u.omega_h = std::sqrt(u.EA / (u.L0() * (u.mass + u.added_min))) * kStep;
   return u;
 }
