@@ -945,7 +945,10 @@ bool CheckStart(const mjModel* m, const mjData* d, const Environment& env,
       << " m apart for a length of " << p.length << " m, a strain of " << strain
       << " and a tension EA x strain = " << p.EA * strain
       << " N at the first step; make the tether at least " << span
-      << " m long unless a pre-tensioned start is meant";
+      << " m long unless a pre-tensioned start is meant (the elastic energy EA x strain^2 x "
+      << "length / 2 = " << 0.5 * p.EA * strain * strain * p.length
+      << " J is released within the first steps, a snap whose outcome depends on <option "
+      << "timestep>: compare with a smaller one)";
     *warning = s.str();
   }
   return true;

@@ -19,8 +19,12 @@
 //                same scene at a 10x smaller MuJoCo step: vehicle position within
 //                max(5 cm, 2% of the span) and the vehicle-end tension averaged over the last
 //                0.2 s within max(0.5 N, 5%) (the criterion for "silently wrong");
-//                and, without a current, the tether's energy never rises above its start by
-//                more than the work its ends did on it (EnergyTolerance, below);
+//                where they disagree, against the scene at 0.02 ms within that tolerance
+//                plus the spread of the two refinements (0.2 vs 0.02 ms: the reference's
+//                own uncertainty, e.g. a mean over snaps); and, without a current, the
+//                tether's energy never rises above its start by more than the work its ends
+//                did on it (EnergyTolerance, below). A stretched start that disagrees is
+//                judged again started unstretched, for the failure's class only;
 //   diverged     stops with a divergence message whose cause this file checks: thrust beyond
 //                EA x max_strain, ends pulled beyond length x (1 + max_strain), an end moving
 //                more than half of max_strain L0 per step, an end below the seabed, a stretched
@@ -262,6 +266,7 @@ struct Run {
   double vehicle_speed = 0;                         // [m/s]
   double tension = 0;                               // [N] mean over the last kAverage
   int warnings = 0;
+  bool stretched = false;       // Attach warned "starts stretched" (a strain above 0.1%)
   double duration = kDuration;  // [s] simulated
   // Energy balance of the tether (scenes without current, see EnergyExcess): the largest
   // E(t) - E(0) - W_ends(t) over the run [J], and the scale the tolerance is taken from.
@@ -290,6 +295,10 @@ struct Run {
 // the (non-positive) power of the dissipative forces on every node.
 double EnergyTolerance(const Run& r) { return 0.05 * (r.gross + r.swing) + 1e-3; }
 
+bool Contains(const std::string& s, const std::string& part) {
+  return s.find(part) != std::string::npos;
+}
+
 // The duration that keeps the scene within kBudget node updates at the step of 2 ms.
 double Duration(const mjModel* m) {
   const Tether* t = GetTether(m, 0);
@@ -311,6 +320,9 @@ Run Simulate(const Scene& s, double step, double duration = -1) {
   mjModel* m = LoadModelFromString(xml, "scene" + std::to_string(s.seed) + ".xml", &run.error);
   if (!m) return run;
   run.loaded = true;
+  for (const std::string& w : Warnings(m)) {
+    run.stretched = run.stretched || Contains(w, "starts stretched");
+  }
   mjData* d = mj_makeData(m);
   t_warnings = 0;
   run.duration = duration > 0 ? duration : Duration(m);
@@ -380,10 +392,6 @@ Run Simulate(const Scene& s, double step, double duration = -1) {
   return run;
 }
 
-bool Contains(const std::string& s, const std::string& part) {
-  return s.find(part) != std::string::npos;
-}
-
 // The outcome of one scene: a class name, pass or fail, and a one-line reason.
 struct Outcome {
   std::string kind;
@@ -434,6 +442,25 @@ Outcome CheckRefusal(const Scene& s, const std::string& error) {
   return {"refused: unrecognised cause", false, error};
 }
 
+// The scene with its tether as long as the span (no start-up strain), the rest unchanged.
+Scene Unstretched(const Scene& s) {
+  Scene u = s;
+  u.length = s.b.norm();
+  std::ostringstream from, to;
+  from.precision(10);
+  to.precision(10);
+  from << " length=" << s.length << " ";
+  to << " length=" << u.length << " ";
+  const size_t at = u.xml.find(from.str());
+  if (at == std::string::npos) {
+    u.xml.clear();  // not found: the caller's run does not load, and nothing is concluded
+  } else {
+    u.xml.replace(at, from.str().size(), to.str());
+  }
+  u.omega_h = std::sqrt(u.EA / (u.L0() * (u.mass + u.added_min))) * kStep;
+  return u;
+}
+
 // The refusals this file predicts from the scene (each must happen).
 std::string ExpectedRefusal(const Scene& s) {
   if (s.seabed_kind == 3) return "an end below the seabed";
@@ -443,6 +470,62 @@ std::string ExpectedRefusal(const Scene& s) {
     return "coupling omega h >= limit";
   }
   return "";
+}
+
+// A run to the end at 2 ms (coarse) against the same scene at 0.2 ms (and, where they
+// disagree, at 0.02 ms), then the energy balance.
+Outcome Compare(const Scene& s, const Run& coarse) {
+  const Run fine = Simulate(s, kStep / 10, coarse.duration);
+  if (!fine.loaded || fine.diverged || !fine.finite || fine.warnings > 0) {
+    return {"fine step failed", false, fine.message.empty() ? fine.error : fine.message};
+  }
+  const double dx = (coarse.vehicle - fine.vehicle).norm();
+  const double dT = std::abs(coarse.tension - fine.tension);
+  const double tol_x = std::max(0.05, 0.02 * s.span);
+  const double tol_T = std::max(0.5, 0.05 * std::max(coarse.tension, fine.tension));
+  std::ostringstream detail;
+  detail << "position " << dx << " m (tol " << tol_x << "), tension " << coarse.tension << " vs "
+         << fine.tension << " N (tol " << tol_T << ")";
+  if (dx > tol_x || dT > tol_T) {
+    // Refined reference (docs/scene_fuzzer.md, open-transient): the 0.2 ms run is a reference
+    // only as far as it is converged. Run the scene again at 0.02 ms and take the spread of
+    // the two refinements, |fine - finer|, as the reference's own uncertainty at that instant
+    // (a tension averaged over 0.2 s of snaps or ringing is sensitive to phase: two fine runs
+    // differ too). The coarse run agrees if it is within the old tolerance (of the finer run)
+    // plus that spread. Where the reference is converged (fine = finer) this is the old
+    // criterion against a better reference, so a coarse run that is wrong still fails.
+    const Run finer = Simulate(s, kStep / 100, coarse.duration);
+    if (!finer.loaded || finer.diverged || !finer.finite || finer.warnings > 0) {
+      detail << "; 0.02 ms run failed: " << (finer.message.empty() ? finer.error : finer.message);
+      return {"disagrees with 10x smaller step", false, detail.str()};
+    }
+    const double spread_x = (fine.vehicle - finer.vehicle).norm();
+    const double spread_T = std::abs(fine.tension - finer.tension);
+    const double dx2 = (coarse.vehicle - finer.vehicle).norm();
+    const double dT2 = std::abs(coarse.tension - finer.tension);
+    const double tol_T2 = std::max(0.5, 0.05 * std::max(coarse.tension, finer.tension));
+    detail << "; 0.02 ms: position " << dx2 << " m (tol " << tol_x << " + spread " << spread_x
+           << "), tension " << finer.tension << " N, off by " << dT2 << " (tol " << tol_T2
+           << " + spread " << spread_T << ")";
+    if (dx2 > tol_x + spread_x || dT2 > tol_T2 + spread_T) {
+      return {"disagrees with 10x smaller step", false, detail.str()};
+    }
+    if (coarse.balanced && coarse.excess > EnergyTolerance(coarse)) {
+      detail << "; energy gain beyond the ends' work " << coarse.excess << " J (tol "
+             << EnergyTolerance(coarse) << ")";
+      return {"tether gains energy beyond the work of its ends", false, detail.str()};
+    }
+    return {"agrees with 100x smaller step within the refinements' spread", true, detail.str()};
+  }
+  if (coarse.balanced) {
+    detail << "; energy gain beyond the ends' work " << coarse.excess << " J (tol "
+           << EnergyTolerance(coarse) << ")";
+    if (coarse.excess > EnergyTolerance(coarse)) {
+      return {"tether gains energy beyond the work of its ends", false, detail.str()};
+    }
+    return {"agrees with 10x smaller step, energy balanced", true, detail.str()};
+  }
+  return {"agrees with 10x smaller step", true, detail.str()};
 }
 
 thread_local bool t_shortened = false;
@@ -523,27 +606,26 @@ Outcome JudgeRuns(const Scene& s) {
     }
     return {"diverged: unrecognised cause", false, msg};
   }
-  const Run fine = Simulate(s, kStep / 10, coarse.duration);
-  if (!fine.loaded || fine.diverged || !fine.finite || fine.warnings > 0) {
-    return {"fine step failed", false, fine.message.empty() ? fine.error : fine.message};
-  }
-  const double dx = (coarse.vehicle - fine.vehicle).norm();
-  const double dT = std::abs(coarse.tension - fine.tension);
-  const double tol_x = std::max(0.05, 0.02 * s.span);
-  const double tol_T = std::max(0.5, 0.05 * std::max(coarse.tension, fine.tension));
-  std::ostringstream detail;
-  detail << "position " << dx << " m (tol " << tol_x << "), tension " << coarse.tension << " vs "
-         << fine.tension << " N (tol " << tol_T << ")";
-  if (dx > tol_x || dT > tol_T) return {"disagrees with 10x smaller step", false, detail.str()};
-  if (coarse.balanced) {
-    detail << "; energy gain beyond the ends' work " << coarse.excess << " J (tol "
-           << EnergyTolerance(coarse) << ")";
-    if (coarse.excess > EnergyTolerance(coarse)) {
-      return {"tether gains energy beyond the work of its ends", false, detail.str()};
-    }
-    return {"agrees with 10x smaller step, energy balanced", true, detail.str()};
-  }
-  return {"agrees with 10x smaller step", true, detail.str()};
+  const Outcome o = Compare(s, coarse);
+  if (o.pass || o.kind != "disagrees with 10x smaller step" || !coarse.stretched) return o;
+  // A stretched start (Attach warned "starts stretched": ends farther apart than the length,
+  // up to max_strain = 1 in these scenes) releases EA x strain into the vehicle within a few
+  // MuJoCo steps: a slingshot whose impulse the 2 ms step resolves only roughly (seed 8: a
+  // mean 2.1 kN over the first 0.25 s at 2 ms, 4.2 kN at 0.2 and 0.02 ms). Diagnosis only, the
+  // scene still fails: the same scene with the tether as long as the span (strain 0, no
+  // warning) is judged too and the result appended, so that tools/scene_fuzz_classify.py can
+  // tell the stretched starts whose unstretched scene agrees. Not accepted as a warned
+  // outcome: the snap can also excite a lasting error of the 2 ms run (seeds 181 and 674 draw=1,
+  // explicit: 2.7e4 against 5.5e3 N and 530 against 45 N over 2-3 s), which the warning does
+  // not explain.
+  Scene u = Unstretched(s);
+  if (!ExpectedRefusal(u).empty()) return o;
+  const Run uc = Simulate(u, kStep, coarse.duration);
+  if (!uc.loaded || uc.diverged || !uc.finite || uc.warnings > 0) return o;
+  const Outcome uo = Compare(u, uc);
+  return {o.kind, false,
+          o.detail + "; started unstretched: " + (uo.pass ? "agrees: " : uo.kind + ": ") +
+              uo.detail};
 }
 
 Outcome Judge(const Scene& s) {
