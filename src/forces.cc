@@ -174,7 +174,8 @@ void Tether::NodeTangents(ConstNodes x, ConstNodes t, Nodes q) const {
 // l_i = (l_{i-1} + l_i)/2, stretched):
 //   f_n = 1/2 rho Cdn d |vn| vn,   f_t = 1/2 rho Cdt pi d |vt| vt,   v_r = u(z_i) - v_i.
 // With a current profile each node sees the current at its own height z_i.
-void Tether::AddDrag(ConstNodes x, ConstNodes v, ConstNodes q, const double* l, Nodes f) const {
+void Tether::AddDrag(ConstNodes x, ConstNodes v, ConstNodes q, const double* l, Nodes f,
+                     double* vn_norm) const {
   const bool current = Has(kCurrent);
   const bool profile = current && !env_.water.profile.empty();
   const Vec3 u0 = current ? env_.water.current : Vec3::Zero();
@@ -185,7 +186,9 @@ void Tether::AddDrag(ConstNodes x, ConstNodes v, ConstNodes q, const double* l, 
     const Vec3 qi = q.col(i);
     const double vq = vr.dot(qi);  // |vt| = |vq|: q is a unit vector
     const Vec3 vn = vr - vq * qi;
-    f.col(i) += li * (kn_ * vn.norm() * vn + (kt_ * std::abs(vq) * vq) * qi);
+    const double vnn = vn.norm();
+    vn_norm[i] = vnn;
+    f.col(i) += li * (kn_ * vnn * vn + (kt_ * std::abs(vq) * vq) * qi);
   }
 }
 
@@ -396,7 +399,7 @@ void Tether::Forces(const double* xp, const double* vp, const Ends& ends, double
     }
   }
   if (Has(kDrag) || Has(kAddedMass) || Has(kSeabed)) NodeTangents(x, tc, q);
-  if (Has(kDrag)) AddDrag(x, v, qc, w.l, f);
+  if (Has(kDrag)) AddDrag(x, v, qc, w.l, f, w.vn);
   if (Has(kSeabed)) AddSeabed(x, v, qc, f, start);
   if (Has(kContact) && ends.contacts) AddContact(x, v, ends, f);
 }
