@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include "detail/work.h"
 
@@ -179,16 +180,25 @@ void Tether::AddDrag(ConstNodes x, ConstNodes v, ConstNodes q, const double* l, 
   const bool current = Has(kCurrent);
   const bool profile = current && !env_.water.profile.empty();
   const Vec3 u0 = current ? env_.water.current : Vec3::Zero();
-  for (int i = 0; i <= N_; ++i) {
-    const double li = DragLength(i, l);
-    const Vec3 u = profile ? env_.water.profile.At(x(2, i)) : u0;
-    const Vec3 vr = u - v.col(i);
-    const Vec3 qi = q.col(i);
-    const double vq = vr.dot(qi);  // |vt| = |vq|: q is a unit vector
-    const Vec3 vn = vr - vq * qi;
-    const double vnn = vn.norm();
-    vn_norm[i] = vnn;
-    f.col(i) += li * (kn_ * vnn * vn + (kt_ * std::abs(vq) * vq) * qi);
+  // The loop compiled twice, with and without keeping |v_n|: the explicit step's force
+  // evaluation (no vn) keeps the code it had.
+  auto nodes = [&](auto keep) {
+    for (int i = 0; i <= N_; ++i) {
+      const double li = DragLength(i, l);
+      const Vec3 u = profile ? env_.water.profile.At(x(2, i)) : u0;
+      const Vec3 vr = u - v.col(i);
+      const Vec3 qi = q.col(i);
+      const double vq = vr.dot(qi);  // |vt| = |vq|: q is a unit vector
+      const Vec3 vn = vr - vq * qi;
+      const double vnn = vn.norm();
+      if constexpr (decltype(keep)::value) vn_norm[i] = vnn;
+      f.col(i) += li * (kn_ * vnn * vn + (kt_ * std::abs(vq) * vq) * qi);
+    }
+  };
+  if (vn_norm) {
+    nodes(std::true_type{});
+  } else {
+    nodes(std::false_type{});
   }
 }
 
@@ -399,7 +409,9 @@ void Tether::Forces(const double* xp, const double* vp, const Ends& ends, double
     }
   }
   if (Has(kDrag) || Has(kAddedMass) || Has(kSeabed)) NodeTangents(x, tc, q);
-  if (Has(kDrag)) AddDrag(x, v, qc, w.l, f, w.vn);
+  // |v_n| is kept for the implicit drag Jacobian in an implicit step's residual (start given);
+  // AddDrag writes it unless the pointer is null.
+  if (Has(kDrag)) AddDrag(x, v, qc, w.l, f, start ? w.vn : nullptr);
   if (Has(kSeabed)) AddSeabed(x, v, qc, f, start);
   if (Has(kContact) && ends.contacts) AddContact(x, v, ends, f);
 }
