@@ -41,6 +41,12 @@ class BlockBand {
   void SetZeroCoupling() {
     for (int i = 0; i < n_; ++i) std::fill(a_ + 27 * i + 9, a_ + 27 * i + 9 * (1 + bands_), 0.0);
   }
+  // Zeroes the second coupling blocks L2 only (with two bands), for a caller that assigns
+  // every diagonal block and every L1 block it uses.
+  void SetZeroL2() {
+    if (bands_ != 2) return;
+    for (int i = 0; i < n_; ++i) std::fill(a_ + 27 * i + 18, a_ + 27 * i + 27, 0.0);
+  }
   Block D(int i) { return Block(a_ + 27 * i); }
   Block L1(int i) { return Block(a_ + 27 * i + 9); }
   Block L2(int i) { return Block(a_ + 27 * i + 18); }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include "detail/work.h"
 
@@ -174,18 +175,30 @@ void Tether::NodeTangents(ConstNodes x, ConstNodes t, Nodes q) const {
 // l_i = (l_{i-1} + l_i)/2, stretched):
 //   f_n = 1/2 rho Cdn d |vn| vn,   f_t = 1/2 rho Cdt pi d |vt| vt,   v_r = u(z_i) - v_i.
 // With a current profile each node sees the current at its own height z_i.
-void Tether::AddDrag(ConstNodes x, ConstNodes v, ConstNodes q, const double* l, Nodes f) const {
+void Tether::AddDrag(ConstNodes x, ConstNodes v, ConstNodes q, const double* l, Nodes f,
+                     double* vn_norm) const {
   const bool current = Has(kCurrent);
   const bool profile = current && !env_.water.profile.empty();
   const Vec3 u0 = current ? env_.water.current : Vec3::Zero();
-  for (int i = 0; i <= N_; ++i) {
-    const double li = DragLength(i, l);
-    const Vec3 u = profile ? env_.water.profile.At(x(2, i)) : u0;
-    const Vec3 vr = u - v.col(i);
-    const Vec3 qi = q.col(i);
-    const double vq = vr.dot(qi);  // |vt| = |vq|: q is a unit vector
-    const Vec3 vn = vr - vq * qi;
-    f.col(i) += li * (kn_ * vn.norm() * vn + (kt_ * std::abs(vq) * vq) * qi);
+  // The loop compiled twice, with and without keeping |v_n|: the explicit step's force
+  // evaluation (no vn) keeps the code it had.
+  auto nodes = [&](auto keep) {
+    for (int i = 0; i <= N_; ++i) {
+      const double li = DragLength(i, l);
+      const Vec3 u = profile ? env_.water.profile.At(x(2, i)) : u0;
+      const Vec3 vr = u - v.col(i);
+      const Vec3 qi = q.col(i);
+      const double vq = vr.dot(qi);  // |vt| = |vq|: q is a unit vector
+      const Vec3 vn = vr - vq * qi;
+      const double vnn = vn.norm();
+      if constexpr (decltype(keep)::value) vn_norm[i] = vnn;
+      f.col(i) += li * (kn_ * vnn * vn + (kt_ * std::abs(vq) * vq) * qi);
+    }
+  };
+  if (vn_norm) {
+    nodes(std::true_type{});
+  } else {
+    nodes(std::false_type{});
   }
 }
 
@@ -396,7 +409,9 @@ void Tether::Forces(const double* xp, const double* vp, const Ends& ends, double
     }
   }
   if (Has(kDrag) || Has(kAddedMass) || Has(kSeabed)) NodeTangents(x, tc, q);
-  if (Has(kDrag)) AddDrag(x, v, qc, w.l, f);
+  // |v_n| is kept for the implicit drag Jacobian in an implicit step's residual (start given);
+  // AddDrag writes it unless the pointer is null.
+  if (Has(kDrag)) AddDrag(x, v, qc, w.l, f, start ? w.vn : nullptr);
   if (Has(kSeabed)) AddSeabed(x, v, qc, f, start);
   if (Has(kContact) && ends.contacts) AddContact(x, v, ends, f);
 }

@@ -33,7 +33,6 @@ EndState Interpolate(const EndState& e0, const EndState& e1, double dt, double s
 constexpr int kLowK[6] = {0, 1, 2, 4, 5, 8};
 constexpr int kLowR[6] = {0, 1, 2, 1, 2, 2};
 constexpr int kLowC[6] = {0, 0, 0, 1, 1, 2};
-constexpr double kI[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};  // the identity, column-major
 
 }  // namespace
 
@@ -249,24 +248,35 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   double* const predicted = w.taut;
   std::fill(predicted, predicted + N_, 0.0);
   auto solve = [&]() {
-    // The mass blocks are assigned, the coupling blocks zeroed: no pass over the whole band.
+    // The mass blocks are assigned, the coupling blocks zeroed or assigned: no pass over the
+    // whole band.
     // The diagonal blocks are symmetric and Factor reads their lower triangle only: the mass,
     // axial and drag terms compute and add those 6 elements (kLowK), each with the expression
     // the full 3x3 product had for it (the same bits); the upper triangle is left as it was.
-    A.SetZeroCoupling();
+    // With the axial term, its loop below assigns the coupling block L1(j) of every segment j
+    // between two dynamic nodes (0 - B, the bits the zeroed block minus B had; zero where the
+    // segment adds nothing), so only L2 is zeroed here.
+    if (Has(kAxial)) {
+      A.SetZeroL2();
+    } else {
+      A.SetZeroCoupling();
+    }
     for (int i = 1; i <= nu; ++i) {
       double* d = A.D(i - 1).data();
       const double m = Mass(i);
       if (added) {
-        // M I + ma (I - q q^T)
+        // M I + ma (I - q q^T), written out with the expressions of the full product:
+        // m + ma (1 - q_r q_r) on the diagonal, 0 + ma (0 - q_r q_c) off it (m 0 = +0).
         const double ma = Added(i);
         const double* qi = w.q + 3 * i;
-        for (int e = 0; e < 6; ++e) {
-          const int k = kLowK[e];
-          d[k] = m * kI[k] + ma * (kI[k] - qi[kLowR[e]] * qi[kLowC[e]]);
-        }
+        d[0] = m + ma * (1 - qi[0] * qi[0]);
+        d[1] = 0 + ma * (0 - qi[1] * qi[0]);
+        d[2] = 0 + ma * (0 - qi[2] * qi[0]);
+        d[4] = m + ma * (1 - qi[1] * qi[1]);
+        d[5] = 0 + ma * (0 - qi[2] * qi[1]);
+        d[8] = m + ma * (1 - qi[2] * qi[2]);
       } else {
-        for (int e = 0; e < 6; ++e) d[kLowK[e]] = m * kI[kLowK[e]];
+        d[0] = m, d[1] = 0, d[2] = 0, d[4] = m, d[5] = 0, d[8] = m;
       }
       if (body && i == N_) {
         for (int e = 0; e < 6; ++e) d[kLowK[e]] += body->mass.data()[kLowK[e]];
@@ -312,7 +322,15 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         // length changes within the step).
         const bool extend = newton && predict && predicted[j] > 0 &&
                             (!taut || (!winch && !(w.T[j] > 0))) && w.l[j] > 0;
-        if (!taut && !extend && !(compression && w.l[j] > 0 && w.l[j] < L0)) continue;
+        const bool d0 = Dynamic(j), d1 = Dynamic(j + 1);
+        // A segment that adds nothing: its coupling block is zero.
+        auto none = [&]() {
+          if (d0 && d1) std::fill_n(A.L1(j).data(), 9, 0.0);
+        };
+        if (!taut && !extend && !(compression && w.l[j] > 0 && w.l[j] < L0)) {
+          none();
+          continue;
+        }
         const double* tj = w.t + 3 * j;
         // B = s t t^T + geo I; full (the coupling block is not symmetric to the bit: the
         // products (s t_r) t_c and (s t_c) t_r may round apart).
@@ -331,7 +349,10 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
           // clipped at zero (it shortens faster than EA eps/damping) is on the piece where
           // the law is 0: its Jacobian there is 0 (the first keeps the linearly implicit step's
           // matrix of before).
-          if (newton && !(w.T[j] > 0)) continue;
+          if (newton && !(w.T[j] > 0)) {
+            none();
+            continue;
+          }
           geo = h2 * w.T[j] / w.l[j];
           cd = w.T[j] > 0 ? ca : 0;
           s = h2 * ka + h * cd - geo;
@@ -345,10 +366,9 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         for (int c = 0; c < 3; ++c) {
           for (int r = 0; r < 3; ++r) B[r + 3 * c] = s * tj[r] * tj[c];
         }
-        if (taut) {
-          for (int k = 0; k < 9; ++k) B[k] += geo * kI[k];
-        }
-        const bool d0 = Dynamic(j), d1 = Dynamic(j + 1);
+        // geo I on the diagonal only (geo 0 = +0 added off it changed no bits: those elements
+        // go into sums that start from +0 or a nonzero value).
+        if (taut) B[0] += geo, B[4] += geo, B[8] += geo;
         if (mixed && j + 1 == N_) {
           // The end segment of a mixed step, node j stepping h and end node B hN: B = h^2 K +
           // h c t t^T, so K = (B - h c t t^T)/h^2; the blocks s_i s_j K + s_i c t t^T (full
@@ -360,6 +380,7 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
           if (d0) A.D(j - 1) += Bm;
           A.D(j) += hN * hN * K + hN * ct;
           if (d0) {
+            none();
             A.L1(j) -= h * hN * K + h * ct;
             end_t = te;
             end_c = (hN - h) * cd;
@@ -376,7 +397,7 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         }
         if (d0 && d1) {
           double* c = A.L1(j).data();
-          for (int k = 0; k < 9; ++k) c[k] -= B[k];
+          for (int k = 0; k < 9; ++k) c[k] = 0 - B[k];
         }
       }
     }
@@ -424,7 +445,7 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         const Vec3 vr = u - vk.col(i);
         const double vq = vr.dot(qi);
         const Vec3 vn = vr - vq * qi;
-        const double vnn = vn.norm();
+        const double vnn = w.vn[i];  // vn.norm(), from AddDrag at this iterate (the residual)
         const double ht = step(i) * li;
         // J = s q q^T + ht kn |vn| I + (ht kn/|vn|) vn vn^T, lower triangle.
         const double s = ht * (kt_ * 2 * std::abs(vq) - kn_ * vnn);

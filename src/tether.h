@@ -242,7 +242,9 @@ class Tether {
   void BendingMoments(ConstNodes t, const Ends& ends, Nodes M) const;
   void AddBending(ConstNodes t, const double* l, ConstNodes M, Nodes f) const;
   void NodeTangents(ConstNodes x, ConstNodes t, Nodes q) const;
-  void AddDrag(ConstNodes x, ConstNodes v, ConstNodes q, const double* l, Nodes f) const;
+  // Also writes each node's |v_n| [m/s] to vn (n values; ImplicitStep's drag Jacobian reads it).
+  void AddDrag(ConstNodes x, ConstNodes v, ConstNodes q, const double* l, Nodes f,
+               double* vn) const;
   void AddSeabed(ConstNodes x, ConstNodes v, ConstNodes q, Nodes f, const Start* start) const;
   void AddSeabedSurface(ConstNodes x, ConstNodes v, ConstNodes q, Nodes f,
                         const Start* start) const;

@@ -58,10 +58,12 @@ struct Work {
   double* dv;    // 3 x n   implicit Newton correction (line search)
   double* vb;    // 3 x n   implicit iterate the line search starts from
   double* taut;  // N       implicit: 1 where the last full Newton step left the segment taut
+  double* vn;    // n       |v_n| of each node's relative normal velocity at the last AddDrag [m/s]
+                 //         (the implicit drag Jacobian reads it: no second square root)
   static int Size(int N) {
     const int n = N + 1;
     return 3 * n + 3 * N + N + N + 3 * n + 3 * n + 3 * n + 3 * n + 3 * n + BlockBand::Size(n) +
-           18 * n + N;
+           18 * n + N + n;
   }
   Work(double* w, int N) {
     const int n = N + 1;
@@ -82,6 +84,7 @@ struct Work {
     dv = v0 + 3 * n;
     vb = dv + 3 * n;
     taut = vb + 3 * n;
+    vn = taut + N;
   }
 };
 
