@@ -134,6 +134,46 @@ double LowestPoint(const Scene& s) {
   return z;
 }
 
+// The compressive strain of the scene's most compressed segment at the start (0: none), with
+// the force EAc x strain over the segment's Euler buckling load pi^2 EI / L0^2 in *over_euler:
+// the initial shape of the engine's own tether (Tether::InitialShape, with the seabed and EAc =
+// EA as declared), which puts every chord at L0 where it can. With one segment it is the
+// geometry alone, 1 - span / length; with more, the walk along the catenary or the V of straight
+// legs fails only on a seabed the V dips below, or on ends closer than L0 with an odd count.
+double StartCompression(const Scene& s, double* over_euler) {
+  *over_euler = 0;
+  if (!(s.EI > 0)) return 0;  // no EAc declared: a short chord is slack
+  TetherParams p;
+  p.length = s.length;
+  p.segments = s.segments;
+  p.diameter = s.diameter;
+  p.mass_per_length = s.mpl;
+  p.EA = p.EAc = s.EA;
+  p.EI = s.EI;
+  p.effects = kAxial | kWeight | kBuoyancy | kCompression;
+  Environment env;
+  env.wet = true;
+  if (s.seabed_kind != 0) {
+    p.effects |= kSeabed;
+    env.water.has_seabed = true;
+    env.water.seabed = s.seabed;
+  }
+  std::string error;
+  std::optional<Tether> t = Tether::Create(p, env, &error);
+  if (!t) return 0;
+  std::vector<double> x(3 * t->nodes()), v(3 * t->nodes());
+  Ends ends;
+  ends.b.pos = s.b;
+  t->InitialShape(ends, x.data(), v.data());
+  double chord = INFINITY;
+  for (int k = 0; k < s.segments; ++k) {
+    chord = std::min(chord, (Vec3(&x[3 * k + 3]) - Vec3(&x[3 * k])).norm() / s.L0());
+  }
+  const double strain = std::max(0.0, 1 - chord);
+  *over_euler = s.EA * strain / (kPi * kPi * s.EI / (s.L0() * s.L0()));
+  return strain;
+}
+
 // Draw versions. Draw 1 (until bdf2 became the default integrator) picks one of four
 // integrators. Draw 2 (the current one) makes the draw-1 scene of the seed, then, from a second
 // stream of its own, replaces its integrator by bdf2 with probability 1/5: each of the five
@@ -435,6 +475,14 @@ Outcome CheckRefusal(const Scene& s, const std::string& error) {
     const double limit = CouplingLimitOf(s);
     return {"refused: coupling omega h >= limit", limit > 0 && s.omega_h >= 0.99 * limit, error};
   }
+  if (Contains(error, "starts compressed")) {
+    // CompressedStart (plugin/plugin.cc): a segment starts shorter than L0 by a strain above
+    // 1e-3 with EAc, and EAc x strain beyond the segment's Euler load.
+    double over_euler = 0;
+    const double strain = StartCompression(s, &over_euler);
+    return {"refused: starts compressed beyond the Euler load", strain > 1e-3 && over_euler > 1,
+            error};
+  }
   if (Contains(error, "substeps per MuJoCo step")) {
     return {"refused: explicit substeps > 1e5", s.integrator == "explicit" || s.integrator == "rk4",
             error};
@@ -468,6 +516,10 @@ std::string ExpectedRefusal(const Scene& s) {
   if (s.L0() < 0.1 * s.diameter) return "segments shorter than d/10";
   if (CouplingLimitOf(s) > 0 && s.omega_h >= 1.01 * CouplingLimitOf(s)) {
     return "coupling omega h >= limit";
+  }
+  double over_euler = 0;
+  if (StartCompression(s, &over_euler) > 1.01e-3 && over_euler > 1.01) {
+    return "starts compressed beyond the Euler load";
   }
   return "";
 }
