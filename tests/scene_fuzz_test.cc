@@ -138,8 +138,8 @@ double LowestPoint(const Scene& s) {
 // the force EAc x strain over the segment's Euler buckling load pi^2 EI / L0^2 in *over_euler:
 // the initial shape of the engine's own tether (Tether::InitialShape, with the seabed and EAc =
 // EA as declared), which puts every chord at L0 where it can. With one segment it is the
-// geometry alone, 1 - span / length; with more, the walk along the catenary or the V of straight
-// legs fails only on a seabed the V dips below, or on ends closer than L0 with an odd count.
+// geometry alone, 1 - span / length; with more, chords of L0 (walked along the catenary or the
+// seabed path, else projected onto L0) unless that fails to converge.
 double StartCompression(const Scene& s, double* over_euler) {
   *over_euler = 0;
   if (!(s.EI > 0)) return 0;  // no EAc declared: a short chord is slack
@@ -580,6 +580,39 @@ Outcome Compare(const Scene& s, const Run& coarse) {
   return {"agrees with 10x smaller step", true, detail.str()};
 }
 
+long EnvLong(const char* name, long fallback) {
+  const char* v = std::getenv(name);
+  return v && *v ? std::strtol(v, nullptr, 10) : fallback;
+}
+
+// The scene run kLate x longer at 2 ms and at 0.2 ms, compared at the end with the oracle's
+// tolerances (position, the vehicle-end tension over the last 0.2 s): "; after the transient
+// (T s): agrees|disagrees: ...". For a stretched start, whose warning says that the snap
+// depends on the step: does the state after it depend on the step too? Diagnosis only, with
+// MJTETHER_SCENE_FUZZ_LATE=1 (it triples the cost of those scenes). Session 10 (s10open), the
+// long run's 70 stretched-start disagreements below omega h = 1: 25 agree after 3 s (the
+// transient only), 44 still disagree (with the 0.2 ms run), one run stopped; no release time
+// pi / (2 omega) in MuJoCo steps (1.6-101 over these) separates the two groups.
+constexpr double kLate = 3;
+std::string AfterTheTransient(const Scene& s, double duration) {
+  const double T = kLate * duration;
+  const Run c = Simulate(s, kStep, T), f = Simulate(s, kStep / 10, T);
+  std::ostringstream out;
+  out << "; after the transient (" << T << " s): ";
+  auto failed = [](const Run& r) { return !r.loaded || r.diverged || !r.finite || r.warnings > 0; };
+  if (failed(c) || failed(f)) {
+    out << "run failed: " << (failed(c) ? c.message + c.error : f.message + f.error);
+    return out.str();
+  }
+  const double dx = (c.vehicle - f.vehicle).norm(), dT = std::abs(c.tension - f.tension);
+  const double tol_x = std::max(0.05, 0.02 * s.span);
+  const double tol_T = std::max(0.5, 0.05 * std::max(c.tension, f.tension));
+  out << (dx <= tol_x && dT <= tol_T ? "agrees" : "disagrees") << ": position " << dx
+      << " m (tol " << tol_x << "), tension " << c.tension << " vs " << f.tension << " N (tol "
+      << tol_T << ")";
+  return out.str();
+}
+
 thread_local bool t_shortened = false;
 thread_local bool t_stalled = false;
 
@@ -670,13 +703,17 @@ Outcome JudgeRuns(const Scene& s) {
   // outcome: the snap can also excite a lasting error of the 2 ms run (seeds 181 and 674 draw=1,
   // explicit: 2.7e4 against 5.5e3 N and 530 against 45 N over 2-3 s), which the warning does
   // not explain.
+  const std::string after =
+      EnvLong("MJTETHER_SCENE_FUZZ_LATE", 0) != 0 ? AfterTheTransient(s, coarse.duration) : "";
   Scene u = Unstretched(s);
-  if (!ExpectedRefusal(u).empty()) return o;
+  if (!ExpectedRefusal(u).empty()) return {o.kind, false, o.detail + after};
   const Run uc = Simulate(u, kStep, coarse.duration);
-  if (!uc.loaded || uc.diverged || !uc.finite || uc.warnings > 0) return o;
+  if (!uc.loaded || uc.diverged || !uc.finite || uc.warnings > 0) {
+    return {o.kind, false, o.detail + after};
+  }
   const Outcome uo = Compare(u, uc);
   return {o.kind, false,
-          o.detail + "; started unstretched: " + (uo.pass ? "agrees: " : uo.kind + ": ") +
+          o.detail + after + "; started unstretched: " + (uo.pass ? "agrees: " : uo.kind + ": ") +
               uo.detail};
 }
 
@@ -704,11 +741,6 @@ std::set<SceneId> ReadSeeds(const std::string& path) {
     seeds.insert(Canonical(seed, draw));
   }
   return seeds;
-}
-
-long EnvLong(const char* name, long fallback) {
-  const char* v = std::getenv(name);
-  return v && *v ? std::strtol(v, nullptr, 10) : fallback;
 }
 
 TEST(SceneFuzz, EveryRandomSceneIsRefusedRunsCorrectlyOrDivergesWithACheckedCause) {
