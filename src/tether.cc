@@ -616,11 +616,20 @@ bool Tether::RestOnLevel(const Ends& ends, double zb, Nodes x) const {
     // at chords of 0.54-0.83 L0 before); kept as it is if that does not converge (the plugin
     // then refuses it if compressed).
     for (int k = 1; k < N_; ++k) x.col(k) = point(p, L * k / N_);
-    Eigen::Matrix3Xd y = x;
-    y.col(0) = A;
-    y.col(N_) = B;
-    if (ProjectOntoChords(y, L0_, [&](Vec3& q) { q = ground(q); })) {
-      for (int k = 1; k < N_; ++k) x.col(k) = y.col(k);
+    // A node pressed onto the seabed below the ends' vertical plane can lengthen its chords
+    // only sideways, where the projection's corrections cancel: it stalls (fuzz seed 7095, 2
+    // segments: stuck at chords 0.79 L0 with the seabed at full precision, converged with it
+    // rounded to 10 digits). Then again from the nodes nudged sideways by L0/100 (along en,
+    // the side of the U).
+    for (const double nudge : {0.0, 0.01 * L0_}) {
+      Eigen::Matrix3Xd y = x;
+      y.col(0) = A;
+      y.col(N_) = B;
+      for (int k = 1; k < N_; ++k) y.col(k) += nudge * en;
+      if (ProjectOntoChords(y, L0_, [&](Vec3& q) { q = ground(q); })) {
+        for (int k = 1; k < N_; ++k) x.col(k) = y.col(k);
+        break;
+      }
     }
   }
   x.col(0) = A;

@@ -143,34 +143,42 @@ double LowestPoint(const Scene& s) {
 double StartCompression(const Scene& s, double* over_euler) {
   *over_euler = 0;
   if (!(s.EI > 0)) return 0;  // no EAc declared: a short chord is slack
+  // The values as the MJCF gives them to the plugin (10 digits, Make).
+  auto xml = [](double v) {
+    std::ostringstream o;
+    o.precision(10);
+    o << v;
+    return std::stod(o.str());
+  };
   TetherParams p;
-  p.length = s.length;
+  p.length = xml(s.length);
   p.segments = s.segments;
-  p.diameter = s.diameter;
-  p.mass_per_length = s.mpl;
-  p.EA = p.EAc = s.EA;
-  p.EI = s.EI;
+  p.diameter = xml(s.diameter);
+  p.mass_per_length = xml(s.mpl);
+  p.EA = p.EAc = xml(s.EA);
+  p.EI = xml(s.EI);
   p.effects = kAxial | kWeight | kBuoyancy | kCompression;
   Environment env;
   env.wet = true;
   if (s.seabed_kind != 0) {
     p.effects |= kSeabed;
     env.water.has_seabed = true;
-    env.water.seabed = s.seabed;
+    env.water.seabed = xml(s.seabed);
   }
   std::string error;
   std::optional<Tether> t = Tether::Create(p, env, &error);
   if (!t) return 0;
   std::vector<double> x(3 * t->nodes()), v(3 * t->nodes());
   Ends ends;
-  ends.b.pos = s.b;
+  ends.b.pos = Vec3(xml(s.b.x()), xml(s.b.y()), xml(s.b.z()));
   t->InitialShape(ends, x.data(), v.data());
   double chord = INFINITY;
+  const double L0 = p.length / p.segments;
   for (int k = 0; k < s.segments; ++k) {
-    chord = std::min(chord, (Vec3(&x[3 * k + 3]) - Vec3(&x[3 * k])).norm() / s.L0());
+    chord = std::min(chord, (Vec3(&x[3 * k + 3]) - Vec3(&x[3 * k])).norm() / L0);
   }
   const double strain = std::max(0.0, 1 - chord);
-  *over_euler = s.EA * strain / (kPi * kPi * s.EI / (s.L0() * s.L0()));
+  *over_euler = p.EAc * strain / (kPi * kPi * p.EI / (L0 * L0));
   return strain;
 }
 
