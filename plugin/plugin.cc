@@ -963,10 +963,11 @@ std::string CompressedStart(const mjModel* m, const mjData* d, const Environment
     << " N: a straight segment cannot buckle, and the first steps would launch the ends apart "
     << "with that force; ";
   // The smallest segment count whose initial shape starts no segment compressed (and whose
-  // segments are not refused as shorter than a tenth of the diameter).
+  // segments are not refused as shorter than a tenth of the diameter), among the next 16 (each
+  // try is one initial shape; the one-segment struts of the fuzzer take 2).
   int fix = 0;
   const int most = std::min<long long>(
-      4 * p.segments + 16,
+      p.segments + 16,
       static_cast<long long>(std::floor(p.length / (kMinSegmentPerDiameter * p.diameter))));
   for (int k = p.segments + 1; k <= most && fix == 0; ++k) {
     TetherParams q = p;
