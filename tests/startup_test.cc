@@ -10,6 +10,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "mujoco_fixture.h"
 #include "param_name.h"
@@ -380,6 +381,38 @@ TEST(StartUpShape, TwoSegmentsWithEAcOnAShortSpanStartAsAVeeAndAgreeWithTheFineS
   EXPECT_LE((coarse.rov - fine.rov).norm(), 0.05);
   EXPECT_LE(std::abs(coarse.tension - fine.tension),
             std::max(0.5, 0.05 * std::max(coarse.tension, fine.tension)));
+}
+
+// Two segments with EAc whose arc-spaced middle node would sit below the seabed (fuzz seed
+// 7095: 101.7 m of line from an anchor 48.7 m above the seabed to an end 13.7 m above it):
+// the seabed walk finds no bracket and used to keep the arc spacing, chords 0.79 and 0.96 L0.
+// Now projected onto chords of L0 with the node lifted onto the seabed (and, at these
+// full-precision values, nudged sideways once: the projection stalls in the ends' plane).
+TEST(StartUpShape, TwoSegmentsWithEAcOverTheSeabedStartAtChordsOfL0OnIt) {
+  TetherParams p;
+  p.length = 101.66817087257775;
+  p.segments = 2;
+  p.diameter = 0.01480483154;
+  p.mass_per_length = 0.3645806722;
+  p.EA = p.EAc = 2896.178072;
+  p.EI = 5.465518655;
+  p.effects = kAxial | kWeight | kBuoyancy | kCompression | kSeabed;
+  Environment env;
+  env.wet = true;
+  env.water.has_seabed = true;
+  env.water.seabed = -48.671847327980835;
+  std::string error;
+  std::optional<Tether> t = Tether::Create(p, env, &error);
+  ASSERT_TRUE(t) << error;
+  std::vector<double> x(9), v(9);
+  Ends ends;
+  ends.b.pos = Vec3(39.865552058042795, -7.1303744654466419, -34.95756439569832);
+  t->InitialShape(ends, x.data(), v.data());
+  for (int k = 0; k < 2; ++k) {
+    const double chord = (Vec3(&x[3 * k + 3]) - Vec3(&x[3 * k])).norm();
+    EXPECT_NEAR(chord / (p.length / 2), 1.0, 1e-9) << "segment " << k;
+  }
+  EXPECT_GE(x[5], env.water.seabed - 1e-12) << "the middle node starts below the seabed";
 }
 
 }  // namespace
