@@ -14,7 +14,8 @@
 //                length x (1 + max_strain), a diameter or segment count out of its threshold,
 //                more than 1e5 explicit substeps, a coupling omega h = sqrt(EA/(L0 (m + a))) h
 //                at the vehicle at or above the advisor's limit for the integrator: explicit 2,
-//                rk4 0.8, implicit2 4, docs/coupling.md);
+//                rk4 0.8, implicit2 4, docs/coupling.md; with EAc, a segment that starts
+//                compressed beyond its Euler load, StartCompression);
 //   agrees       runs to the end, every value finite, no MuJoCo warning, and agrees with the
 //                same scene at a 10x smaller MuJoCo step: vehicle position within
 //                max(5 cm, 2% of the span) and the vehicle-end tension averaged over the last
