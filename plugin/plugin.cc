@@ -870,7 +870,12 @@ int FreeCarrier(const mjModel* m, int body) {
 //   against Irvine's catenary; d/10 is the limit kept).
 constexpr double kMinDensity = 1.2;            // [kg/m^3] air
 constexpr double kMinSegmentPerDiameter = 0.1;  // [-] L0 / d
-// A start stretched beyond this strain is far from equilibrium: warned with its tension.
+// A start stretched beyond this strain is far from equilibrium: warned with its tension. The
+// warning says that the outcome depends on the step for seconds after the snap: of the 70
+// stretched starts of session 9's long run that disagreed with their 0.2 ms selves at 1 s,
+// 44 still disagreed at 3 s (snap trains that implicit2 and bdf2 damp at 2 ms, explicit
+// coupling growth), 25 agreed (docs/scene_fuzzer.md, s10open). With EAc, a start compressed
+// beyond this strain is refused or warned (CompressedStart).
 constexpr double kStretchWarning = 1e-3;  // [-]
 
 bool CheckParameters(const TetherParams& p, bool wet, std::string* error) {
@@ -897,6 +902,87 @@ bool CheckParameters(const TetherParams& p, bool wet, std::string* error) {
   }
   *error = s.str();
   return false;
+}
+
+// The shortest chord of a tether's initial shape between ends at a and b, over L0 (1: no
+// segment starts compressed); site A's x-axis for the shapes that use it.
+double ShortestStartChord(const Tether& t, const Vec3& a, const Vec3& b, const Vec3& axis) {
+  Ends ends;
+  ends.a.pos = a;
+  ends.a.axis = axis;
+  ends.b.pos = b;
+  std::vector<double> x(3 * t.nodes()), v(3 * t.nodes());
+  t.InitialShape(ends, x.data(), v.data());
+  const double L0 = t.params().length / t.params().segments;
+  double shortest = INFINITY;
+  for (int k = 0; k + 1 < t.nodes(); ++k) {
+    shortest = std::min(shortest, (Vec3(&x[3 * k + 3]) - Vec3(&x[3 * k])).norm() / L0);
+  }
+  return shortest;
+}
+
+// A tether with EAc whose initial shape starts a segment compressed (Tether::InitialShape puts
+// every chord at L0 where it can: by a walk along the catenary or the seabed path, else by
+// projecting the arc spacing onto chords of L0; not with one segment on ends closer than its
+// length, nor where the projection does not converge: on the long run's 9,800 scenes, never).
+// Returns "" if no segment starts compressed by more than kStretchWarning; "refuse:" and the
+// message if the compressive force EAc x strain exceeds the segment's Euler buckling load
+// pi^2 EI / L0^2 (a straight segment cannot buckle, so the first steps launch the ends apart
+// with that force, which the declared cable could not carry); else a warning.
+// Measured (session 9's long run, seeds 201..10000): 196 scenes of one segment with EAc loaded
+// with the ends closer than the length, at compressive strains 0.028-0.67 and forces 31-2e14 x
+// the Euler load (none below it); 18 of them failed (17 disagreed with their fine-step selves,
+// class open-one-two-segments: the 2 ms run resolves a launch by e.g. 8.6 MN into a 470 kg
+// vehicle, seed 7190, only roughly, then rings undamped about the length; one bad qacc), 46
+// stopped with a cause the fuzzer accepted (end damping too stiff at the launch speed, thrust,
+// ends pulled apart), and the 132 that agreed are the same strut, well resolved.
+std::string CompressedStart(const mjModel* m, const mjData* d, const Environment& env,
+                            const AttachedTether& at, const Vec3& a, const Vec3& b) {
+  const Tether& t = at.tether;
+  const TetherParams& p = t.params();
+  if (!(p.effects & kCompression) || at.winch) return "";
+  const Vec3 axis(d->site_xmat[9 * at.site[0]], d->site_xmat[9 * at.site[0] + 3],
+                  d->site_xmat[9 * at.site[0] + 6]);
+  const double chord = ShortestStartChord(t, a, b, axis), strain = 1 - chord;
+  if (!(strain > kStretchWarning)) return "";
+  const double L0 = p.length / p.segments, force = p.EAc * strain;
+  const double euler = 9.86960440108935862 * p.EI / (L0 * L0);  // [N] pi^2 EI / L0^2
+  std::ostringstream s;
+  s << "starts compressed: its " << p.segments << " segment" << (p.segments > 1 ? "s" : "")
+    << " of " << L0 << " m cannot hang the length of " << p.length << " m between ends "
+    << (b - a).norm() << " m apart (sites '" << mj_id2name(m, mjOBJ_SITE, at.site[0]) << "', '"
+    << mj_id2name(m, mjOBJ_SITE, at.site[1]) << "'), so a segment starts at a chord of " << chord
+    << " x its length, a compressive strain of " << strain << " and a force EAc x strain = "
+    << force << " N";
+  if (force <= euler) {
+    s << ", below its Euler buckling load pi^2 EI / L0^2 = " << euler
+      << " N (a straight strut), released within the first steps";
+    return s.str();
+  }
+  s << ", beyond its Euler buckling load pi^2 EI / L0^2 = " << euler
+    << " N: a straight segment cannot buckle, and the first steps would launch the ends apart "
+    << "with that force; ";
+  // The smallest segment count whose initial shape starts no segment compressed (and whose
+  // segments are not refused as shorter than a tenth of the diameter), among the next 16 (each
+  // try is one initial shape; the one-segment struts of the fuzzer take 2).
+  int fix = 0;
+  const int most = std::min<long long>(
+      p.segments + 16,
+      static_cast<long long>(std::floor(p.length / (kMinSegmentPerDiameter * p.diameter))));
+  for (int k = p.segments + 1; k <= most && fix == 0; ++k) {
+    TetherParams q = p;
+    q.segments = k;
+    std::string ignored;
+    std::optional<Tether> candidate = Tether::Create(q, env, &ignored);
+    if (candidate && !(1 - ShortestStartChord(*candidate, a, b, axis) > kStretchWarning)) fix = k;
+  }
+  if (fix > 0) {
+    s << "use at least " << fix << " segments (every segment then starts at its length), or "
+      << "remove EAc";
+  } else {
+    s << "remove EAc, or move the ends " << p.length << " m apart";
+  }
+  return "refuse:" + s.str();
 }
 
 // The positions of the ends at the start (qpos0, mocap bodies at their model positions):
@@ -940,6 +1026,14 @@ bool CheckStart(const mjModel* m, const mjData* d, const Environment& env,
     *error = s.str();
     return false;
   }
+  if (std::string compressed = CompressedStart(m, d, env, at, a, b); !compressed.empty()) {
+    if (compressed.rfind("refuse:", 0) == 0) {
+      *error = compressed.substr(7);
+      return false;
+    }
+    *warning = compressed;
+    return true;
+  }
   if (strain > kStretchWarning) {
     s << "starts stretched, far from equilibrium: the ends are " << span
       << " m apart for a length of " << p.length << " m, a strain of " << strain
@@ -947,8 +1041,9 @@ bool CheckStart(const mjModel* m, const mjData* d, const Environment& env,
       << " N at the first step; make the tether at least " << span
       << " m long unless a pre-tensioned start is meant (the elastic energy EA x strain^2 x "
       << "length / 2 = " << 0.5 * p.EA * strain * strain * p.length
-      << " J is released within the first steps, a snap whose outcome depends on <option "
-      << "timestep>: compare with a smaller one)";
+      << " J is released within the first steps, a snap whose outcome, and the slack-taut "
+      << "bouncing it may start, depend on <option timestep> for seconds after: compare with "
+      << "a smaller one)";
     *warning = s.str();
   }
   return true;

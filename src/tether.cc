@@ -10,6 +10,46 @@ namespace mjtether {
 using namespace detail;
 namespace {
 
+// Moves the interior nodes of y (3 x (N+1), the ends fixed) so that every chord is L0:
+// nonlinear Gauss-Seidel on |y_k+1 - y_k| = L0 (as SHAKE/RATTLE do for rigid bonds), each sweep
+// moving both nodes of a segment along it by half its length error (the node next to an end
+// by all of it), then `floor` (a node lifted onto the seabed, or nothing). True if every chord
+// ends within 1e-9 L0 of L0; y is then the shape (else it is left as it came out).
+template <class Floor>
+bool ProjectOntoChords(Eigen::Matrix3Xd& y, double L0, Floor&& floor) {
+  const int N = static_cast<int>(y.cols()) - 1;
+  if (N < 2) return false;
+  double worst = INFINITY;
+  for (int sweep = 0; sweep < 20000 && !(worst <= 1e-10 * L0); ++sweep) {
+    worst = 0;
+    for (int k = 0; k < N; ++k) {
+      const Vec3 d = y.col(k + 1) - y.col(k);
+      const double l = d.norm();
+      if (!(l > 1e-12 * L0)) return false;  // coincident nodes: no direction to push along
+      worst = std::max(worst, std::abs(l - L0));
+      const Vec3 c = (l - L0) / l * d;  // [m] shortens d by l - L0
+      if (k == 0) {
+        y.col(k + 1) -= c;
+      } else if (k + 1 == N) {
+        y.col(k) += c;
+      } else {
+        y.col(k) += 0.5 * c;
+        y.col(k + 1) -= 0.5 * c;
+      }
+    }
+    for (int k = 1; k < N; ++k) {
+      Vec3 p = y.col(k);
+      floor(p);
+      y.col(k) = p;
+    }
+  }
+  for (int k = 0; k < N; ++k) {
+    if (!(std::abs((y.col(k + 1) - y.col(k)).norm() - L0) <= 1e-9 * L0)) return false;
+  }
+  return true;
+}
+
+
 // Largest stable step of classical RK4 [s] for the modes of a chain whose highest frequency is
 // w [rad/s] with damping ratio zeta. Internal damping is stiffness-proportional, so a mode of
 // frequency s w has ratio s zeta and eigenvalues s w (-s zeta +- i sqrt(1 - s^2 zeta^2)) (real
@@ -314,7 +354,25 @@ void Tether::InitialShape(const Ends& ends, double* xp, double* vp) const {
         L2 = L3;
         f2 = walk(L2, false);
       }
-      if (std::isfinite(f2) && std::abs(f2) <= 1e-9 * L) walk(L2, true);
+      if (std::isfinite(f2) && std::abs(f2) <= 1e-9 * L) {
+        walk(L2, true);
+      } else {
+        // The walk fails on a deep U (a chord's Newton step passes the bottom, slope <= 0) or
+        // its secant leaves the bracket: every one of the 319 session-9 fuzz scenes of 2-244
+        // segments with EAc that started compressed (chords 0.18-0.999 L0; 2 segments on a
+        // span of a third of the length: 0.18 L0, EAc x 0.82 pushing the vehicle away at the
+        // first step). Instead project the arc-spaced nodes onto chords of L0 (nonlinear
+        // Gauss-Seidel, ProjectOntoChords above). The shape stays near the catenary (for 2
+        // segments the middle node goes to the point a chord L0 from both ends below the
+        // chord). Kept only if every chord ends within 1e-9 L0 of L0; otherwise the arc
+        // spacing stays and the plugin refuses the compressed start at load
+        // (plugin/plugin.cc, CompressedStart).
+        Eigen::Matrix3Xd y = x;
+        y.col(N_) = B;
+        if (ProjectOntoChords(y, L0_, [](Vec3&) {})) {
+          for (int k = 1; k < N_; ++k) x.col(k) = y.col(k);
+        }
+      }
     }
     x.col(N_) = B;  // remove round-off at the far end
   }
@@ -552,7 +610,27 @@ bool Tether::RestOnLevel(const Ends& ends, double zb, Nodes x) const {
   if (ok) {
     F(-flo < fhi ? lo : hi);
   } else {
+    // No bracket (e.g. 2 segments whose one interior node cannot be a chord L0 from both ends
+    // on this path): the arc spacing, projected onto chords of L0 above the seabed
+    // (ProjectOntoChords; 15 session-9 fuzz scenes of 2-7 segments that started on the seabed
+    // at chords of 0.54-0.83 L0 before); kept as it is if that does not converge (the plugin
+    // then refuses it if compressed).
     for (int k = 1; k < N_; ++k) x.col(k) = point(p, L * k / N_);
+    // A node pressed onto the seabed below the ends' vertical plane can lengthen its chords
+    // only sideways, where the projection's corrections cancel: it stalls (fuzz seed 7095, 2
+    // segments: stuck at chords 0.79 L0 with the seabed at full precision, converged with it
+    // rounded to 10 digits). Then again from the nodes nudged sideways by L0/100 (along en,
+    // the side of the U).
+    for (const double nudge : {0.0, 0.01 * L0_}) {
+      Eigen::Matrix3Xd y = x;
+      y.col(0) = A;
+      y.col(N_) = B;
+      for (int k = 1; k < N_; ++k) y.col(k) += nudge * en;
+      if (ProjectOntoChords(y, L0_, [&](Vec3& q) { q = ground(q); })) {
+        for (int k = 1; k < N_; ++k) x.col(k) = y.col(k);
+        break;
+      }
+    }
   }
   x.col(0) = A;
   x.col(N_) = B;

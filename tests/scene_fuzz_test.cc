@@ -14,7 +14,8 @@
 //                length x (1 + max_strain), a diameter or segment count out of its threshold,
 //                more than 1e5 explicit substeps, a coupling omega h = sqrt(EA/(L0 (m + a))) h
 //                at the vehicle at or above the advisor's limit for the integrator: explicit 2,
-//                rk4 0.8, implicit2 4, docs/coupling.md);
+//                rk4 0.8, implicit2 4, docs/coupling.md; with EAc, a segment that starts
+//                compressed beyond its Euler load, StartCompression);
 //   agrees       runs to the end, every value finite, no MuJoCo warning, and agrees with the
 //                same scene at a 10x smaller MuJoCo step: vehicle position within
 //                max(5 cm, 2% of the span) and the vehicle-end tension averaged over the last
@@ -132,6 +133,54 @@ double LowestPoint(const Scene& s) {
   double z = 0;
   for (int i = 0; i < t->nodes(); ++i) z = std::min(z, x[3 * i + 2]);
   return z;
+}
+
+// The compressive strain of the scene's most compressed segment at the start (0: none), with
+// the force EAc x strain over the segment's Euler buckling load pi^2 EI / L0^2 in *over_euler:
+// the initial shape of the engine's own tether (Tether::InitialShape, with the seabed and EAc =
+// EA as declared), which puts every chord at L0 where it can. With one segment it is the
+// geometry alone, 1 - span / length; with more, chords of L0 (walked along the catenary or the
+// seabed path, else projected onto L0) unless that fails to converge.
+double StartCompression(const Scene& s, double* over_euler) {
+  *over_euler = 0;
+  if (!(s.EI > 0)) return 0;  // no EAc declared: a short chord is slack
+  // The values as the MJCF gives them to the plugin (10 digits, Make).
+  auto xml = [](double v) {
+    std::ostringstream o;
+    o.precision(10);
+    o << v;
+    return std::stod(o.str());
+  };
+  TetherParams p;
+  p.length = xml(s.length);
+  p.segments = s.segments;
+  p.diameter = xml(s.diameter);
+  p.mass_per_length = xml(s.mpl);
+  p.EA = p.EAc = xml(s.EA);
+  p.EI = xml(s.EI);
+  p.effects = kAxial | kWeight | kBuoyancy | kCompression;
+  Environment env;
+  env.wet = true;
+  if (s.seabed_kind != 0) {
+    p.effects |= kSeabed;
+    env.water.has_seabed = true;
+    env.water.seabed = xml(s.seabed);
+  }
+  std::string error;
+  std::optional<Tether> t = Tether::Create(p, env, &error);
+  if (!t) return 0;
+  std::vector<double> x(3 * t->nodes()), v(3 * t->nodes());
+  Ends ends;
+  ends.b.pos = Vec3(xml(s.b.x()), xml(s.b.y()), xml(s.b.z()));
+  t->InitialShape(ends, x.data(), v.data());
+  double chord = INFINITY;
+  const double L0 = p.length / p.segments;
+  for (int k = 0; k < s.segments; ++k) {
+    chord = std::min(chord, (Vec3(&x[3 * k + 3]) - Vec3(&x[3 * k])).norm() / L0);
+  }
+  const double strain = std::max(0.0, 1 - chord);
+  *over_euler = p.EAc * strain / (kPi * kPi * p.EI / (L0 * L0));
+  return strain;
 }
 
 // Draw versions. Draw 1 (until bdf2 became the default integrator) picks one of four
@@ -435,6 +484,14 @@ Outcome CheckRefusal(const Scene& s, const std::string& error) {
     const double limit = CouplingLimitOf(s);
     return {"refused: coupling omega h >= limit", limit > 0 && s.omega_h >= 0.99 * limit, error};
   }
+  if (Contains(error, "starts compressed")) {
+    // CompressedStart (plugin/plugin.cc): a segment starts shorter than L0 by a strain above
+    // 1e-3 with EAc, and EAc x strain beyond the segment's Euler load.
+    double over_euler = 0;
+    const double strain = StartCompression(s, &over_euler);
+    return {"refused: starts compressed beyond the Euler load", strain > 1e-3 && over_euler > 1,
+            error};
+  }
   if (Contains(error, "substeps per MuJoCo step")) {
     return {"refused: explicit substeps > 1e5", s.integrator == "explicit" || s.integrator == "rk4",
             error};
@@ -468,6 +525,10 @@ std::string ExpectedRefusal(const Scene& s) {
   if (s.L0() < 0.1 * s.diameter) return "segments shorter than d/10";
   if (CouplingLimitOf(s) > 0 && s.omega_h >= 1.01 * CouplingLimitOf(s)) {
     return "coupling omega h >= limit";
+  }
+  double over_euler = 0;
+  if (StartCompression(s, &over_euler) > 1.01e-3 && over_euler > 1.01) {
+    return "starts compressed beyond the Euler load";
   }
   return "";
 }
@@ -526,6 +587,39 @@ Outcome Compare(const Scene& s, const Run& coarse) {
     return {"agrees with 10x smaller step, energy balanced", true, detail.str()};
   }
   return {"agrees with 10x smaller step", true, detail.str()};
+}
+
+long EnvLong(const char* name, long fallback) {
+  const char* v = std::getenv(name);
+  return v && *v ? std::strtol(v, nullptr, 10) : fallback;
+}
+
+// The scene run kLate x longer at 2 ms and at 0.2 ms, compared at the end with the oracle's
+// tolerances (position, the vehicle-end tension over the last 0.2 s): "; after the transient
+// (T s): agrees|disagrees: ...". For a stretched start, whose warning says that the snap
+// depends on the step: does the state after it depend on the step too? Diagnosis only, with
+// MJTETHER_SCENE_FUZZ_LATE=1 (it triples the cost of those scenes). Session 10 (s10open), the
+// long run's 70 stretched-start disagreements below omega h = 1: 25 agree after 3 s (the
+// transient only), 44 still disagree (with the 0.2 ms run), one run stopped; no release time
+// pi / (2 omega) in MuJoCo steps (1.6-101 over these) separates the two groups.
+constexpr double kLate = 3;
+std::string AfterTheTransient(const Scene& s, double duration) {
+  const double T = kLate * duration;
+  const Run c = Simulate(s, kStep, T), f = Simulate(s, kStep / 10, T);
+  std::ostringstream out;
+  out << "; after the transient (" << T << " s): ";
+  auto failed = [](const Run& r) { return !r.loaded || r.diverged || !r.finite || r.warnings > 0; };
+  if (failed(c) || failed(f)) {
+    out << "run failed: " << (failed(c) ? c.message + c.error : f.message + f.error);
+    return out.str();
+  }
+  const double dx = (c.vehicle - f.vehicle).norm(), dT = std::abs(c.tension - f.tension);
+  const double tol_x = std::max(0.05, 0.02 * s.span);
+  const double tol_T = std::max(0.5, 0.05 * std::max(c.tension, f.tension));
+  out << (dx <= tol_x && dT <= tol_T ? "agrees" : "disagrees") << ": position " << dx
+      << " m (tol " << tol_x << "), tension " << c.tension << " vs " << f.tension << " N (tol "
+      << tol_T << ")";
+  return out.str();
 }
 
 thread_local bool t_shortened = false;
@@ -618,13 +712,17 @@ Outcome JudgeRuns(const Scene& s) {
   // outcome: the snap can also excite a lasting error of the 2 ms run (seeds 181 and 674 draw=1,
   // explicit: 2.7e4 against 5.5e3 N and 530 against 45 N over 2-3 s), which the warning does
   // not explain.
+  const std::string after =
+      EnvLong("MJTETHER_SCENE_FUZZ_LATE", 0) != 0 ? AfterTheTransient(s, coarse.duration) : "";
   Scene u = Unstretched(s);
-  if (!ExpectedRefusal(u).empty()) return o;
+  if (!ExpectedRefusal(u).empty()) return {o.kind, false, o.detail + after};
   const Run uc = Simulate(u, kStep, coarse.duration);
-  if (!uc.loaded || uc.diverged || !uc.finite || uc.warnings > 0) return o;
+  if (!uc.loaded || uc.diverged || !uc.finite || uc.warnings > 0) {
+    return {o.kind, false, o.detail + after};
+  }
   const Outcome uo = Compare(u, uc);
   return {o.kind, false,
-          o.detail + "; started unstretched: " + (uo.pass ? "agrees: " : uo.kind + ": ") +
+          o.detail + after + "; started unstretched: " + (uo.pass ? "agrees: " : uo.kind + ": ") +
               uo.detail};
 }
 
@@ -652,11 +750,6 @@ std::set<SceneId> ReadSeeds(const std::string& path) {
     seeds.insert(Canonical(seed, draw));
   }
   return seeds;
-}
-
-long EnvLong(const char* name, long fallback) {
-  const char* v = std::getenv(name);
-  return v && *v ? std::strtol(v, nullptr, 10) : fallback;
 }
 
 TEST(SceneFuzz, EveryRandomSceneIsRefusedRunsCorrectlyOrDivergesWithACheckedCause) {

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "mujoco_fixture.h"
 #include "param_name.h"
@@ -298,6 +299,120 @@ TEST_F(StartUpDivergence, HangingLinePulledPastMaxStrainAtTheTopIsNamedAsPulled)
   EXPECT_TRUE(Contains(message, "the ends were pulled")) << message;
   EXPECT_TRUE(Contains(message, "prescribed motion of body 'tms'")) << message;
   EXPECT_FALSE(Contains(message, "Reduce <option timestep>")) << message;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Compressed starts with EAc (session 10, s10open; docs/scene_fuzzer.md, "one-two segments and
+// stretched starts"). A tether of 10 m with EAc between ends 6 m apart.
+
+std::string CompressedXml(int segments, const std::string& integrator, double timestep) {
+  std::ostringstream s;
+  s << R"(<mujoco><option timestep=")" << timestep << R"("/><custom>
+    <text name="water" data="density=1025"/>
+    <text name="vehicle:rov" data="volume=0.0195 added_mass=10,10,10,0.1,0.1,0.1
+          linear_damping=20,20,20,1,1,1 coriolis=0"/>
+    <text name="tether:u" data="ends=tms_site,att length=10 segments=)"
+    << segments << R"( diameter=0.01 mass_per_length=0.1
+          EA=1e6 EAc=1e6 EI=0.01 Cdn=1.2 Cdt=0.01 Can=1 integrator=)"
+    << integrator << R"("/>
+  </custom><worldbody><body name="tms" mocap="true"><site name="tms_site"/></body>
+    <body name="rov" pos="4.8 0 -3.6"><freejoint/><inertial pos="0 0 0" mass="20"
+          diaginertia="0.3 0.3 0.3"/><site name="att"/></body></worldbody></mujoco>)";
+  return s.str();
+}
+
+// One segment cannot hang 10 m between ends 6 m apart: it starts as a strut compressed by 0.4,
+// pushing with EAc x 0.4 = 4e5 N, far beyond its Euler load pi^2 EI / L^2 = 9.9e-4 N. Before,
+// the run launched the vehicle with that force (fuzz seed 7190: 8.6 MN into 470 kg).
+TEST(StartUpRefusal, OneSegmentCompressedBeyondItsEulerLoadExitWith2NamingTheFix) {
+  std::string out;
+  EXPECT_EQ(RunCli(CompressedXml(1, "implicit", 0.002), "strut.xml", &out), 2) << out;
+  EXPECT_TRUE(Contains(out, "strut.xml: <text name=\"tether:u\">: starts compressed")) << out;
+  EXPECT_TRUE(Contains(out, "a compressive strain of 0.4 and a force EAc x strain = 400000 N"))
+      << out;
+  EXPECT_TRUE(Contains(out, "beyond its Euler buckling load")) << out;
+  EXPECT_TRUE(Contains(out, "use at least 2 segments")) << out;
+  EXPECT_TRUE(Contains(out, "or remove EAc")) << out;
+  // Without EAc the short chord is slack: no force, no refusal.
+  std::string xml = CompressedXml(1, "implicit", 0.002);
+  xml.replace(xml.find(" EAc=1e6"), 8, "");
+  EXPECT_EQ(RunCli(xml, "slack.xml", &out), 0) << out;
+}
+
+// Two segments with EAc: the catenary walk of chords L0 fails on this deep U (Newton's slope
+// turns negative past its bottom), and the start used to keep the arc spacing, chords of
+// 0.995 and 0.72 L0, the second pushing with EAc x 0.28 = 2.8e5 N. Now the V of two straight legs: both chords
+// L0 (to round-off), and the run agrees with its fine-step self (the fuzzer's criterion:
+// position within 5 cm, the vehicle-end tension over the last 0.2 s within max(0.5 N, 5%)).
+TEST(StartUpShape, TwoSegmentsWithEAcOnAShortSpanStartAsAVeeAndAgreeWithTheFineStep) {
+  struct Result {
+    Vec3 rov;
+    double tension = 0;
+  };
+  auto run = [](double timestep) {
+    testing::LoadedScene scene(CompressedXml(2, "implicit", timestep), "vee.xml");
+    mjModel* m = scene.m;
+    mjData* d = scene.d;
+    mj_forward(m, d);
+    const double* x = NodePositions(m, d, 0);
+    for (int k = 0; k < 2; ++k) {
+      const double chord = std::hypot(std::hypot(x[3 * k + 3] - x[3 * k], x[3 * k + 4] - x[3 * k + 1]),
+                                      x[3 * k + 5] - x[3 * k + 2]);
+      EXPECT_NEAR(chord, 5.0, 1e-9) << "segment " << k;
+    }
+    EXPECT_LT(x[5], -3.6) << "the middle node hangs below the chord";
+    Result r;
+    const int steps = static_cast<int>(std::lround(1.0 / timestep));
+    const int from = steps - static_cast<int>(std::lround(0.2 / timestep));
+    for (int k = 0; k < steps; ++k) {
+      mj_step(m, d);
+      std::optional<std::string> message = CheckDivergence(m, d);
+      EXPECT_FALSE(message) << *message;
+      if (message) break;
+      if (k >= from) r.tension += GetReactions(m, d, 0).tension_b / (steps - from);
+    }
+    r.rov = Vec3(d->xpos + 3 * mj_name2id(m, mjOBJ_BODY, "rov"));
+    return r;
+  };
+  const Result coarse = run(0.002), fine = run(0.0002);
+  std::printf("vee: rov %.4f %.4f %.4f / %.4f %.4f %.4f m, tension %.4f / %.4f N\n",
+              coarse.rov.x(), coarse.rov.y(), coarse.rov.z(), fine.rov.x(), fine.rov.y(),
+              fine.rov.z(), coarse.tension, fine.tension);
+  EXPECT_LE((coarse.rov - fine.rov).norm(), 0.05);
+  EXPECT_LE(std::abs(coarse.tension - fine.tension),
+            std::max(0.5, 0.05 * std::max(coarse.tension, fine.tension)));
+}
+
+// Two segments with EAc whose arc-spaced middle node would sit below the seabed (fuzz seed
+// 7095: 101.7 m of line from an anchor 48.7 m above the seabed to an end 13.7 m above it):
+// the seabed walk finds no bracket and used to keep the arc spacing, chords 0.79 and 0.96 L0.
+// Now projected onto chords of L0 with the node lifted onto the seabed (and, at these
+// full-precision values, nudged sideways once: the projection stalls in the ends' plane).
+TEST(StartUpShape, TwoSegmentsWithEAcOverTheSeabedStartAtChordsOfL0OnIt) {
+  TetherParams p;
+  p.length = 101.66817087257775;
+  p.segments = 2;
+  p.diameter = 0.01480483154;
+  p.mass_per_length = 0.3645806722;
+  p.EA = p.EAc = 2896.178072;
+  p.EI = 5.465518655;
+  p.effects = kAxial | kWeight | kBuoyancy | kCompression | kSeabed;
+  Environment env;
+  env.wet = true;
+  env.water.has_seabed = true;
+  env.water.seabed = -48.671847327980835;
+  std::string error;
+  std::optional<Tether> t = Tether::Create(p, env, &error);
+  ASSERT_TRUE(t) << error;
+  std::vector<double> x(9), v(9);
+  Ends ends;
+  ends.b.pos = Vec3(39.865552058042795, -7.1303744654466419, -34.95756439569832);
+  t->InitialShape(ends, x.data(), v.data());
+  for (int k = 0; k < 2; ++k) {
+    const double chord = (Vec3(&x[3 * k + 3]) - Vec3(&x[3 * k])).norm();
+    EXPECT_NEAR(chord / (p.length / 2), 1.0, 1e-9) << "segment " << k;
+  }
+  EXPECT_GE(x[5], env.water.seabed - 1e-12) << "the middle node starts below the seabed";
 }
 
 }  // namespace
