@@ -63,16 +63,32 @@ inline Vec3 Tether::Acceleration(int i, const Vec3& fi, const Vec3& qi) const {
   return InvMass(i) * ft + InvMassNormal(i) * (fi - ft);
 }
 
-// Symplectic (semi-implicit) Euler: v += h M^-1 f(x, v); x += h v.
+// Acceleration of end node B carrying a body (the consistent coupling, docs/coupling.md):
+//   (m I + ma (I - q q^T) + W^-1) a = f + W^-1 a_other,
+// the node's mass matrix (as in Acceleration) plus the body's effective mass at the site W^-1
+// [kg], under the node's force plus the force W^-1 a_other [N] that gives the site the
+// acceleration it has without the tether. The explicit schemes' share of what ImplicitStep
+// assembles for the same node; one 3x3 SPD solve (Cholesky).
+Vec3 Tether::BodyEndAcceleration(const Vec3& fi, const Vec3& qi, const EndInertia& body) const {
+  Mat3 M = body.mass + Mass(N_) * Mat3::Identity();
+  if (Has(kAddedMass)) M += Added(N_) * (Mat3::Identity() - qi * qi.transpose());
+  return M.llt().solve(fi + body.force);
+}
+
+// Symplectic (semi-implicit) Euler: v += h M^-1 f(x, v); x += h v. With a body at end B
+// (WithDynamicEndB), end node B steps the same way with the body's inertia and force
+// (BodyEndAcceleration): it only gets heavier, so the stable step of the chain stands.
 void Tether::ExplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
                           double* work) const {
   Work w(work, N_);
   ComputeForces(x.data(), v.data(), now, w.f, nullptr, work);
   AccumulateContactImpulse(x.data(), v.data(), now, h, false);  // v+ = v + h M^-1 f(x, v)
   ConstNodes f(w.f, 3, N_ + 1), q(w.q, 3, N_ + 1);
+  const EndInertia* body = dynamic_b_ ? now.body_b : nullptr;
   for (int i = 1; i <= N_; ++i) {
     if (!Dynamic(i)) continue;
-    v.col(i) += h * Acceleration(i, f.col(i), q.col(i));
+    v.col(i) += h * (body && i == N_ ? BodyEndAcceleration(f.col(i), q.col(i), *body)
+                                     : Acceleration(i, f.col(i), q.col(i)));
     x.col(i) += h * v.col(i);
   }
   PlaceEnds(next, x, v);
@@ -92,6 +108,8 @@ void Tether::Rk4Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double
   Nodes xk(w.x2, 3, n), vk(w.v2, 3, n), dx(w.xs, 3, n), dv(w.vs, 3, n);
   ConstNodes f(w.f, 3, n), q(w.q, 3, n);
   const Ends mid = Interpolate(now, next, h, 0.5);
+  // A body at end B (WithDynamicEndB): end node B carries its inertia in every stage.
+  const EndInertia* body = dynamic_b_ ? now.body_b : nullptr;
   // Stage k at (xk, vk), ends `e`: k_k = (vk, a_k) is added to the sum (dx, dv) with weight
   // b = 1, 2, 2, 1, and the next stage state is y + c h k_k with c = 1/2, 1/2, 1; the last
   // stage completes y + h/6 (k1 + 2 k2 + 2 k3 + k4). One pass over the nodes per stage.
@@ -106,7 +124,9 @@ void Tether::Rk4Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double
     AccumulateContactImpulse(xk.data(), vk.data(), e, b[k] * h / 6, false);
     for (int i = 0; i < n; ++i) {
       if (!Dynamic(i)) continue;
-      const Vec3 ai = Acceleration(i, f.col(i), q.col(i)), vi = vk.col(i);
+      const Vec3 ai = body && i == N_ ? BodyEndAcceleration(f.col(i), q.col(i), *body)
+                                      : Acceleration(i, f.col(i), q.col(i));
+      const Vec3 vi = vk.col(i);
       if (k == 0) {
         dx.col(i) = vi;
         dv.col(i) = ai;

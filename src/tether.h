@@ -106,9 +106,9 @@ class Tether {
                                       std::string* error);
   // The same tether with its end node B stepped as a dynamic node (the consistent coupling,
   // docs/coupling.md): Advance places only end A, and end node B moves under its forces plus
-  // Ends::body_b's (its mass and force added to the node's). Implicit schemes only (implicit,
-  // implicit2, bdf2); params().free_end stays false, so InitialShape and Reactions are the
-  // attached tether's.
+  // Ends::body_b's (its mass and force added to the node's), in every integrator's step (the
+  // explicit schemes solve the node's 3x3 mass in each substep or stage); params().free_end
+  // stays false, so InitialShape and Reactions are the attached tether's.
   Tether WithDynamicEndB() const {
     Tether t = *this;
     t.dynamic_b_ = true;
@@ -270,6 +270,7 @@ class Tether {
   // Integrators (one step of size h; ends already set at the start, `next` at the end).
   void PlaceEnds(const Ends& e, Nodes x, Nodes v) const;
   Vec3 Acceleration(int i, const Vec3& fi, const Vec3& qi) const;
+  Vec3 BodyEndAcceleration(const Vec3& fi, const Vec3& qi, const EndInertia& body) const;
   void ExplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
                     double* work) const;
   void Rk4Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
