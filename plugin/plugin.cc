@@ -316,9 +316,10 @@ void CountStalls(const StepStatus& status, double time, double* u) {
 constexpr double kLeadFrom = 1;
 // implicit2 (session 10, s10i2: end node B takes SDIRK's velocity stages and the body's
 // position step, Sdirk2Step) from this omega h on: the scene fuzzer's implicit2 scenes failed
-// in 14.3% of scenes at omega h 0.5-1 with the held force and 11.1% with this (18.7% -> 9.3%
-// at 1-2, 26.4% -> 9.9% at 2-4), but in 8.7% -> 13.7% at 0.1-0.25, about even at 0.25-0.5;
-// the BlueROV2 at omega h 0.26 (EA 6e4) is 1.5% off in tension with it, 0.58% without.
+// in 14.3% of scenes at omega h 0.5-1 with the held force and 11.1% with this (18.7% -> 10.3%
+// at 1-2, 26.4% -> 11.0% at 2-4, 8.8% at >= 4, refused before), but with it from 0.1 in 8.7% ->
+// 13.7% at 0.1-0.25 and 16.2% -> 14.7% at 0.25-0.5; the BlueROV2 at omega h 0.26 (EA 6e4) is
+// 1.5% off in tension with it, 0.58% without (docs/coupling.md, implicit2).
 constexpr double kLeadFromImplicit2 = 0.5;
 
 // A tether with the consistent coupling at end B (AttachedTether::lead; docs/coupling.md).
