@@ -313,7 +313,7 @@ void CountStalls(const StepStatus& status, double time, double* u) {
 // consistent one, which integrates the body-end mode with backward Euler, damps that mode
 // (2.3%). integrator=implicit and bdf2 (whose end node B takes a backward-Euler step inside
 // the BDF2 step: with BDF2's history the body kept accelerating after a snap, 0.68 N s from
-// nothing); not implicit2 (it lost the anchor's impulse).
+// nothing); implicit2 from kLeadFromImplicit2 (below).
 constexpr double kLeadFrom = 1;
 // integrator=explicit from this omega h on (docs/coupling.md, "explicit and rk4 (session 10,
 // s10exp)"): end node B steps in the explicit substeps with the body's inertia
@@ -324,6 +324,13 @@ constexpr double kLeadFrom = 1;
 // to 18 at 0.5-0.8), the held force being fourth order in the tether and the consistent
 // coupling first order at the body.
 constexpr double kLeadFromExplicit = 0.5;
+// implicit2 (session 10, s10i2: end node B takes SDIRK's velocity stages and the body's
+// position step, Sdirk2Step) from this omega h on: the scene fuzzer's implicit2 scenes failed
+// in 14.3% of scenes at omega h 0.5-1 with the held force and 11.1% with this (18.7% -> 10.3%
+// at 1-2, 26.4% -> 11.0% at 2-4, 8.8% at >= 4, refused before), but with it from 0.1 in 8.7% ->
+// 13.7% at 0.1-0.25 and 16.2% -> 14.7% at 0.25-0.5; the BlueROV2 at omega h 0.26 (EA 6e4) is
+// 1.5% off in tension with it, 0.58% without (docs/coupling.md, implicit2).
+constexpr double kLeadFromImplicit2 = 0.5;
 
 // A tether with the consistent coupling at end B (AttachedTether::lead; docs/coupling.md).
 // At a callback at a new time t the tether is at t (stepped there at the last callback): end
@@ -337,7 +344,9 @@ constexpr double kLeadFromExplicit = 0.5;
 // velocity change end node B had, so the body carries the end's response within the step and
 // action and reaction match over it. A callback again at the time it stepped from (mj_forward
 // then mj_step at the same t) re-applies that force; a time that went back, a reset or a
-// teleported end restarts from the initial shape.
+// teleported end restarts from the initial shape. With implicit2 end node B takes SDIRK's
+// velocity stages and the body's position step (Sdirk2Step) and end A's reported force is the
+// step's mean, its stages' impulse over the step.
 void EvaluateLead(const mjModel* m, mjData* d, const AttachedTether& at, double* work,
                   double* jac) {
   double* u = d->userdata + at.offset;
@@ -399,7 +408,8 @@ void EvaluateLead(const mjModel* m, mjData* d, const AttachedTether& at, double*
   to.a.pos += dt * now.a.vel;
   to.b.pos += dt * now.b.vel;
   from.body_b = to.body_b = &body;
-  // The interval's times: with bdf2 end node B steps over it by backward Euler (ImplicitStep).
+  // The interval's times: with bdf2 end node B steps over it by backward Euler, with implicit2
+  // its position does (ImplicitStep's mixed step).
   from.time = c[kLeadTime];
   to.time = c[kLeadTime] + dt;
   const StepStatus status = tether.Advance(x.data(), v.data(), from, to, dt, work, history);
@@ -414,6 +424,12 @@ void EvaluateLead(const mjModel* m, mjData* d, const AttachedTether& at, double*
   after.b.vel = v.col(N);
   after.body_b = nullptr;
   EndReactions r = tether.Reactions(x.data(), v.data(), after, work);
+  // implicit2: end A's force is the step's mean, its stages' impulse over dt (the force at
+  // t + h alone is not what its nodes' momentum took: docs/coupling.md, implicit2).
+  if (tether.params().integrator == Integrator::kImplicit2) {
+    r.force_a = status.impulse_a / dt;
+    r.tension_a = r.force_a.norm();
+  }
   for (int i = 0; i < 3; ++i) {
     cache[i] = r.force_a[i];
     cache[3 + i] = r.torque_a[i];
@@ -1315,15 +1331,20 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
                 : p.integrator == Integrator::kImplicit2 ? kCouplingLimitImplicit2
                                                          : 0;
       // The consistent coupling (EvaluateLead) where the held force is not resolved.
+      // implicit2 and explicit from their own thresholds. implicit2's refusal limit is then
+      // lifted (the limit is the held force's); explicit's stays (with the consistent coupling
+      // its tension swung by kN at omega h 3.36 on the BlueROV2 case, docs/coupling.md).
       const bool implicit_lead =
           p.integrator == Integrator::kImplicit || p.integrator == Integrator::kBdf2;
-      const double lead_from = implicit_lead                            ? kLeadFrom
-                               : p.integrator == Integrator::kExplicit ? kLeadFromExplicit
-                                                                        : INFINITY;
+      const double lead_from = implicit_lead                             ? kLeadFrom
+                               : p.integrator == Integrator::kImplicit2 ? kLeadFromImplicit2
+                               : p.integrator == Integrator::kExplicit  ? kLeadFromExplicit
+                                                                         : INFINITY;
       if (end == 1 && c.omega_h >= lead_from &&
           !at.coupled[0] && !at.winch && !at.contact && !p.clamp_b &&
           FreeCarrier(m, at.body[1]) > 0 && m->opt.integrator != mjINT_RK4) {
         at.lead = t.WithDynamicEndB();
+        if (p.integrator == Integrator::kImplicit2) c.limit = 0;
       }
       c.applies = c.limit > 0;
       if (!c.applies) continue;
@@ -1334,11 +1355,12 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
         << " (omega = sqrt(k_end/m_eff) = sqrt(" << c.k_end << " N/m / " << c.m_eff
         << " kg) = " << c.omega << " rad/s, <option timestep> " << h << " s), limit " << c.limit
         << (p.integrator == Integrator::kImplicit2
-                ? "; use integrator=implicit (measured within 1% at omega h 10.6), or <option "
+                ? "; use integrator=bdf2 (the default) or implicit (measured within 1% at "
+                  "omega h 10.6), or <option "
                 : "; use integrator=implicit or bdf2 (stable at any omega h measured) or "
-                  "implicit2 (up to omega h 4), or <option ")
-        << "timestep> <= "
-        << c.limit / c.omega << " s, or fewer segments or a smaller EA";
+                  "implicit2 (not limited on a free body at end B with end A fixed, up to "
+                  "omega h 4 elsewhere), or <option ")
+        << "timestep> <= " << c.limit / c.omega << " s, or fewer segments or a smaller EA";
       if (c.omega_h >= c.limit) {
         *error = where + s.str();
         ok = false;

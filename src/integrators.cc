@@ -34,6 +34,17 @@ constexpr int kLowK[6] = {0, 1, 2, 4, 5, 8};
 constexpr int kLowR[6] = {0, 1, 2, 1, 2, 2};
 constexpr int kLowC[6] = {0, 0, 0, 1, 1, 2};
 
+// The tether's force on end A [N] with end node B dynamic (its state from the node, not the
+// site): Reactions at the state x, v and the ends e.
+Vec3 EndForceA(const Tether& t, const double* x, const double* v, const Ends& e, double* work) {
+  const int N = t.segments();
+  Ends at = e;
+  at.b.pos = Eigen::Map<const Vec3>(x + 3 * N);
+  at.b.vel = Eigen::Map<const Vec3>(v + 3 * N);
+  at.body_b = nullptr;
+  return t.Reactions(x, v, at, work).force_a;
+}
+
 }  // namespace
 
 Ends Interpolate(const Ends& from, const Ends& to, double dt, double s) {
@@ -194,10 +205,18 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   // next.time - now.time, for end node B (the mixed step, see Bdf2Step: the other nodes take
   // BDF2's backward-Euler step of he from their extrapolated state, end node B a plain
   // backward-Euler step over the interval from its own state; EvaluateLead sets the times).
+  // implicit2's second stage (Sdirk2Step) is mixed too: end node B's velocity takes SDIRK's
+  // stage of h (gamma h here) from its v~, M_B (v_B+ - v~_B) = h (f_B + W^-1 a_other), and its
+  // position x_B+ = x_B + hN v_B+ from its own start, as the body's Euler step does. Its row
+  // is scaled by cN = hN/h, cN M_B (v_B+ - v~_B) = hN (f_B + W^-1 a_other), so that the matrix
+  // has the per-node steps s_i of the bdf2 mixed step (symmetric in K) and end node B the mass
+  // cN M_B (cN = 1 with bdf2).
   const double span = next.time - now.time;  // [s]
-  const bool mixed = body && p_.integrator == Integrator::kBdf2 && span > 0 &&
+  const bool sdirk = p_.integrator == Integrator::kImplicit2;
+  const bool mixed = body && (p_.integrator == Integrator::kBdf2 || sdirk) && span > 0 &&
                      std::abs(span - h) > 1e-9 * h;
   const double hN = mixed ? span : h;
+  const double cN = mixed && sdirk ? hN / h : 1;  // [-] end node B's mass scale
   auto step = [&](int i) { return i == N_ ? hN : h; };
   Nodes xk(w.x2, 3, n), vk(w.v2, 3, n);
   // Initial iterate: velocities unchanged, ends at the end of the step.
@@ -236,7 +255,9 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
     Forces(w.x2, w.v2, next, w.f, w.T, work, &start);
     double phi = 0, worst = 0;
     for (int i = 1; i <= nu; ++i) {
-      const Vec3 dvi = vk.col(i) - v.col(i);
+      // (End node B of an implicit2 mixed stage: its mass scaled by cN, above.)
+      const Vec3 dvi =
+          i == N_ && cN != 1 ? Vec3(cN * (vk.col(i) - v.col(i))) : Vec3(vk.col(i) - v.col(i));
       Vec3 r = step(i) * f.col(i) - Mass(i) * dvi;
       if (added) {
         const Vec3 qi = q.col(i);
@@ -247,7 +268,7 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         // The body's share: (W^-1 + m) dv = h (f + W^-1 a_other); G weighted by the inverse
         // of the smallest total mass along a direction.
         r += hN * body->force - body->mass * dvi;
-        inv = 1 / (Mass(i) + body_min_mass);
+        inv = 1 / (cN * (Mass(i) + body_min_mass));
       }
       rhs.col(i - 1) = r;
       const double r2 = r.squaredNorm();
@@ -300,6 +321,9 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
       }
       if (body && i == N_) {
         for (int e = 0; e < 6; ++e) d[kLowK[e]] += body->mass.data()[kLowK[e]];
+        if (cN != 1) {
+          for (int e = 0; e < 6; ++e) d[kLowK[e]] *= cN;
+        }
       }
     }
     // Axial stiffness and damping of taut segments: B = h D + h^2 K with
@@ -821,6 +845,9 @@ void Tether::ImplicitStepAdaptive(Nodes x, Nodes v, const Ends& now, const Ends&
     if (!converged) ++stats->stalled_steps;
     // Backward Euler: M (v+ - v) = h f(x+, v+), so the impulse is h times the final force.
     AccumulateContactImpulse(x.data(), v.data(), next, impulse_weight * h, false);
+    if (dynamic_b_ && next.body_b && p_.integrator == Integrator::kImplicit2) {
+      stats->impulse_a += impulse_weight * h * EndForceA(*this, x.data(), v.data(), next, work);
+    }
     return;
   }
   ++stats->halvings;
@@ -858,6 +885,8 @@ void Tether::Sdirk2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, dou
     ImplicitStepAdaptive(x, v, now, next, h, 0, work, stats);
   };
   if (!ImplicitStep(x, v, now, mid, kGamma * h, work, stats)) return fall_back();
+  const bool mixed = dynamic_b_ && next.body_b && next.time > now.time;
+  const Vec3 fa1 = mixed ? EndForceA(*this, x.data(), v.data(), mid, work) : Vec3::Zero();
   // Contact impulse: y+ = y + (1 - gamma) h F(Y1) + gamma h F(Y2); the first part is kept
   // aside until the second stage settles (a fallback replaces both).
   if (Has(kContact) && mid.contacts) {
@@ -868,13 +897,26 @@ void Tether::Sdirk2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, dou
     AccumulateContactImpulse(x.data(), v.data(), mid, (1 - kGamma) * h, true);
   }
   // x, v hold Y1; form y~ on the dynamic nodes (the ends are set by the next stage).
+  // A body at end B (the consistent coupling, docs/coupling.md): end node B carries the body,
+  // whose Euler step moves it to x + h v+; end node B takes SDIRK's velocity, v~ and a stage of
+  // gamma h, but its position from its own start, x_B+ = x_B + h v_B+ (the mixed stage of
+  // ImplicitStep, which takes end node B's position step from the stage's times: `from`
+  // starts at t). Both stages weigh its forces as every other node's, (1 - gamma) h at Y1 and
+  // gamma h at Y2, so the end segment's impulse on the body and on the tether match.
   const double a = (1 - kGamma) / kGamma;
   for (int i = 0; i < n; ++i) {
     if (!Dynamic(i)) continue;
-    x.col(i) = x0.col(i) + (1 - kGamma) * h * v.col(i);
+    x.col(i) = x0.col(i);
+    if (!(mixed && i == N_)) x.col(i) += (1 - kGamma) * h * v.col(i);
     v.col(i) = v0.col(i) + a * (v.col(i) - v0.col(i));
   }
-  if (!ImplicitStep(x, v, mid, next, kGamma * h, work, stats)) return fall_back();
+  Ends from = mid;
+  if (mixed) from.time = now.time;
+  if (!ImplicitStep(x, v, from, next, kGamma * h, work, stats)) return fall_back();
+  if (mixed) {
+    stats->impulse_a +=
+        (1 - kGamma) * h * fa1 + kGamma * h * EndForceA(*this, x.data(), v.data(), next, work);
+  }
   if (Has(kContact) && next.contacts) {
     for (int k = 0; k < next.contacts->count; ++k) {
       ContactPoint& c = next.contacts->points[k];

@@ -96,6 +96,11 @@ struct StepStatus {
   // sum over tether steps of the end node's force (at the step's evaluation) times the end's
   // displacement. What the tether gave the bodies, for the coupling's work balance.
   double work_a = 0, work_b = 0;
+  // [N s] implicit2 with end B dynamic (WithDynamicEndB): the impulse of the tether's force on
+  // end A over the advance as the scheme integrates it, (1 - gamma) h and gamma h times the
+  // force at its two stages (h times the force at the end of a backward-Euler step where it
+  // falls back), from which EvaluateLead reports end A's force. Zero otherwise.
+  Vec3 impulse_a = Vec3::Zero();
 };
 
 class Tether {
