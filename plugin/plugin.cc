@@ -424,9 +424,11 @@ void EvaluateLead(const mjModel* m, mjData* d, const AttachedTether& at, double*
   after.b.vel = v.col(N);
   after.body_b = nullptr;
   EndReactions r = tether.Reactions(x.data(), v.data(), after, work);
-  // implicit2: end A's force is the step's mean, its stages' impulse over dt (the force at
-  // t + h alone is not what its nodes' momentum took: docs/coupling.md, implicit2).
-  if (tether.params().integrator == Integrator::kImplicit2) {
+  // implicit2 and explicit: end A's force is the step's mean, its stages' or substeps'
+  // impulse over dt (the force at t + h alone is not what its nodes' momentum took:
+  // docs/coupling.md, implicit2).
+  if (tether.params().integrator == Integrator::kImplicit2 ||
+      tether.params().integrator == Integrator::kExplicit) {
     r.force_a = status.impulse_a / dt;
     r.tension_a = r.force_a.norm();
   }
