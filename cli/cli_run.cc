@@ -254,8 +254,16 @@ int Info(const std::string& path) {
                 << BodyName(m, c.body) << "'): k_end = EA/L0 = " << c.k_end
                 << " N/m, m_eff = " << c.m_eff << " kg, omega = " << c.omega
                 << " rad/s, omega h = " << c.omega_h;
+      if (c.consistent) {
+        std::cout << "; consistent coupling (end node B solved with the body in the tether's "
+                     "step)";
+      } else if (c.omega_h > 0) {
+        std::cout << "; held end force";
+      }
       if (c.applies) {
         std::cout << "; limit " << c.limit;
+      } else if (c.consistent) {
+        std::cout << "; no limit";
       } else {
         std::cout << "; no limit for " << mjtether::IntegratorName(p.integrator) << " (explicit "
                   << mjtether::kCouplingLimitExplicit << ", rk4 " << mjtether::kCouplingLimitRk4

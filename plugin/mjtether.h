@@ -71,6 +71,9 @@ struct CouplingLimit {
   double omega_h = 0;    // [-] omega times <option timestep>
   double limit = 0;      // [-] omega h refused at load (explicit and rk4 tethers)
   bool applies = false;  // the limit applies (integrator explicit or rk4)
+  // The consistent coupling is on at this end: end node B solved with the body's effective
+  // mass inside the tether's step (docs/coupling.md); otherwise the body gets the held force.
+  bool consistent = false;
 };
 CouplingLimit GetCouplingLimit(const mjModel* m, int k, int end);
 // An explicit or rk4 tether on a body whose coupling frequency gives omega h at or above this

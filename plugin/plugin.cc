@@ -1346,6 +1346,7 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
           !at.coupled[0] && !at.winch && !at.contact && !p.clamp_b &&
           FreeCarrier(m, at.body[1]) > 0 && m->opt.integrator != mjINT_RK4) {
         at.lead = t.WithDynamicEndB();
+        c.consistent = true;
         if (p.integrator == Integrator::kImplicit2) c.limit = 0;
       }
       c.applies = c.limit > 0;

@@ -584,6 +584,13 @@ TEST(CouplingCli, RefusalExitsWith2AndInfoPrintsEachLimit) {
   EXPECT_TRUE(Contains(output, "estimated cost ")) << output;
   EXPECT_TRUE(Contains(output, "coupling at end B (body 'rov'): k_end = EA/L0 = 1e+07 N/m"))
       << output;
+  // Which coupling the body gets: consistent at omega h 3.36 (>= kLeadFrom), held at 0.26.
+  EXPECT_TRUE(Contains(output, "; consistent coupling (end node B solved with the body")) << output;
+  EXPECT_TRUE(Contains(output, "; no limit")) << output;
+  const std::string held = ::testing::TempDir() + "/coupling_held.xml";
+  std::ofstream(held) << BlueRovXml("6e4", "implicit", 0.002);
+  EXPECT_EQ(RunCli("info " + held, &output), 0) << output;
+  EXPECT_TRUE(Contains(output, "; held end force; no limit for implicit")) << output;
 }
 
 }  // namespace
