@@ -279,6 +279,19 @@ TEST_F(Coupling, ChatterBelowTheLimitAdvisesASmallerStepAndBdf2) {
   EXPECT_LT(worst, 0.5);
 }
 
+// The yanked-vehicle scene of the tests below: dry, no gravity, an 11.5 kg body on a 10 m
+// tether of 1 m segments (EA 1e7 N, no damping) from a mocap anchor, `integrator` at step h.
+std::string YankXml(const std::string& integrator, double h) {
+  return R"(<mujoco><option timestep=")" + std::to_string(h) + R"(" gravity="0 0 0"/>
+  <custom><text name="tether:t" data="ends=anchor,hook length=10 segments=10 diameter=0.01
+        mass_per_length=0.05 EA=1e7 integrator=)" +
+         integrator + R"("/></custom>
+  <worldbody><body name="a" mocap="true"><site name="anchor"/></body>
+    <body name="v" pos="10.2 0 0"><freejoint/>
+      <inertial pos="0 0 0" mass="11.5" diaginertia="0.16 0.16 0.16"/>
+      <site name="hook" pos="-0.2 0 0"/></body></worldbody></mujoco>)";
+}
+
 // A free vehicle yanked by a taut stiff tether gains no energy beyond the work done on it.
 // Dry, no gravity: an 11.5 kg body (inertia 0.16 kg m^2, tether site 0.2 m off its centre)
 // on a 10 m tether of 1 m segments, EA = 1e7 N, no damping, straight at its rest length; end A
@@ -298,15 +311,7 @@ TEST_F(Coupling, ChatterBelowTheLimitAdvisesASmallerStepAndBdf2) {
 TEST_F(Coupling, YankedVehicleGainsNoEnergyBeyondTheWork) {
   for (const char* integrator : {"implicit", "implicit2", "bdf2", "rk4", "explicit"}) {
     for (double h : {0.002, 0.0005, 0.00025}) {
-      const std::string xml = R"(<mujoco><option timestep=")" + std::to_string(h) +
-                              R"(" gravity="0 0 0"><flag energy="enable"/></option>
-  <custom><text name="tether:t" data="ends=anchor,hook length=10 segments=10 diameter=0.01
-        mass_per_length=0.05 EA=1e7 integrator=)" +
-                              integrator + R"("/></custom>
-  <worldbody><body name="a" mocap="true"><site name="anchor"/></body>
-    <body name="v" pos="10.2 0 0"><freejoint/>
-      <inertial pos="0 0 0" mass="11.5" diaginertia="0.16 0.16 0.16"/>
-      <site name="hook" pos="-0.2 0 0"/></body></worldbody></mujoco>)";
+      const std::string xml = YankXml(integrator, h);
       std::string error;
       mjModel* m = LoadModelFromString(xml, "yank.xml", &error);
       if (!m) {
@@ -388,15 +393,7 @@ struct YankEnergy {
 };
 YankEnergy RunYank(const char* integrator, double h, int stride) {
   YankEnergy out;
-  const std::string xml = R"(<mujoco><option timestep=")" + std::to_string(h) +
-                          R"(" gravity="0 0 0"/>
-  <custom><text name="tether:t" data="ends=anchor,hook length=10 segments=10 diameter=0.01
-        mass_per_length=0.05 EA=1e7 integrator=)" +
-                          integrator + R"("/></custom>
-  <worldbody><body name="a" mocap="true"><site name="anchor"/></body>
-    <body name="v" pos="10.2 0 0"><freejoint/>
-      <inertial pos="0 0 0" mass="11.5" diaginertia="0.16 0.16 0.16"/>
-      <site name="hook" pos="-0.2 0 0"/></body></worldbody></mujoco>)";
+  const std::string xml = YankXml(integrator, h);
   std::string error;
   mjModel* m = LoadModelFromString(xml, "yank.xml", &error);
   EXPECT_NE(m, nullptr) << error;
