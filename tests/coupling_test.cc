@@ -139,6 +139,7 @@ TEST_F(Coupling, ImplicitTethersAreNotLimited) {
   ASSERT_NE(m, nullptr);
   const CouplingLimit c = GetCouplingLimit(m, 0, 1);
   EXPECT_FALSE(c.applies);
+  EXPECT_TRUE(c.consistent);  // omega h >= kLeadFrom = 1 on a free body
   EXPECT_GT(c.omega_h, 10);
   EXPECT_TRUE(Warnings(m).empty());
 }
@@ -154,6 +155,7 @@ TEST_F(Coupling, Implicit2IsLimitedOnlyWithTheHeldForce) {
   ASSERT_NE(m, nullptr);
   const CouplingLimit c = GetCouplingLimit(m, 0, 1);
   EXPECT_FALSE(c.applies);
+  EXPECT_TRUE(c.consistent);
   EXPECT_GT(c.omega_h, 10);
   EXPECT_TRUE(Warnings(m).empty());
   std::string xml = BlueRovXml("1e8", "implicit2", 0.002);
