@@ -99,10 +99,10 @@ struct AttachedTether {
   bool coupled[2] = {false, false};
   CouplingLimit limit[2];  // the time-step advisor's figures at load time
   // The consistent coupling (docs/coupling.md): end B on a free body, integrator implicit,
-  // bdf2 or explicit (from kLeadFrom, kLeadFromExplicit), no winch, contact or clamp at B,
-  // MuJoCo's Euler or implicit integrator. The tether then steps one MuJoCo step ahead with
-  // its end node B dynamic (this copy, Tether::WithDynamicEndB), carrying the body's
-  // effective mass, and the body gets the force consistent with that step.
+  // bdf2, implicit2 or explicit (from kLeadFrom, kLeadFromImplicit2, kLeadFromExplicit), no
+  // winch, contact or clamp at B, MuJoCo's Euler or implicit integrator. The tether then steps
+  // one MuJoCo step ahead with its end node B dynamic (this copy, Tether::WithDynamicEndB),
+  // carrying the body's effective mass, and the body gets the force consistent with that step.
   std::optional<Tether> lead;
   // A winch (winch:NAME, docs/winch.md) at internal end A (sites swapped when declared at B).
   bool winch = false;
@@ -424,11 +424,10 @@ void EvaluateLead(const mjModel* m, mjData* d, const AttachedTether& at, double*
   after.b.vel = v.col(N);
   after.body_b = nullptr;
   EndReactions r = tether.Reactions(x.data(), v.data(), after, work);
-  // implicit2 and explicit: end A's force is the step's mean, its stages' or substeps'
-  // impulse over dt (the force at t + h alone is not what its nodes' momentum took:
-  // docs/coupling.md, implicit2).
-  if (tether.params().integrator == Integrator::kImplicit2 ||
-      tether.params().integrator == Integrator::kExplicit) {
+  // Where the scheme integrates end A's force over the step (implicit2's stages, explicit's
+  // substeps), its mean: the force at t + h alone is not what its nodes' momentum took
+  // (docs/coupling.md, implicit2; StepStatus::impulse_a).
+  if (status.has_impulse_a) {
     r.force_a = status.impulse_a / dt;
     r.tension_a = r.force_a.norm();
   }

@@ -847,6 +847,7 @@ void Tether::ImplicitStepAdaptive(Nodes x, Nodes v, const Ends& now, const Ends&
     AccumulateContactImpulse(x.data(), v.data(), next, impulse_weight * h, false);
     if (dynamic_b_ && next.body_b && p_.integrator == Integrator::kImplicit2) {
       stats->impulse_a += impulse_weight * h * EndForceA(*this, x.data(), v.data(), next, work);
+      stats->has_impulse_a = true;
     }
     return;
   }
@@ -916,6 +917,7 @@ void Tether::Sdirk2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, dou
   if (mixed) {
     stats->impulse_a +=
         (1 - kGamma) * h * fa1 + kGamma * h * EndForceA(*this, x.data(), v.data(), next, work);
+    stats->has_impulse_a = true;
   }
   if (Has(kContact) && next.contacts) {
     for (int k = 0; k < next.contacts->count; ++k) {
@@ -1039,6 +1041,7 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
     // substeps, each of which took the force at its start (plugin: end A's force is its mean).
     if (p_.integrator == Integrator::kExplicit && dynamic_b_ && next.body_b) {
       status.impulse_a += h * Vec3(f.col(0));
+      status.has_impulse_a = true;
     }
     if (!DynamicB()) status.work_b += f.col(N_).dot(next.b.pos - now.b.pos);
     now = next;

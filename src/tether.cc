@@ -49,7 +49,6 @@ bool ProjectOntoChords(Eigen::Matrix3Xd& y, double L0, Floor&& floor) {
   return true;
 }
 
-
 // Largest stable step of classical RK4 [s] for the modes of a chain whose highest frequency is
 // w [rad/s] with damping ratio zeta. Internal damping is stiffness-proportional, so a mode of
 // frequency s w has ratio s zeta and eigenvalues s w (-s zeta +- i sqrt(1 - s^2 zeta^2)) (real

@@ -96,11 +96,14 @@ struct StepStatus {
   // sum over tether steps of the end node's force (at the step's evaluation) times the end's
   // displacement. What the tether gave the bodies, for the coupling's work balance.
   double work_a = 0, work_b = 0;
-  // [N s] implicit2 with end B dynamic (WithDynamicEndB): the impulse of the tether's force on
-  // end A over the advance as the scheme integrates it, (1 - gamma) h and gamma h times the
-  // force at its two stages (h times the force at the end of a backward-Euler step where it
-  // falls back), from which EvaluateLead reports end A's force. Zero otherwise.
+  // [N s] With end B dynamic (WithDynamicEndB), for the schemes whose end A force at the end
+  // of the step is not what their nodes' momentum took: the impulse of the tether's force on
+  // end A over the advance as the scheme integrates it. implicit2: (1 - gamma) h and gamma h
+  // times the force at its two stages (h times the force at the end of a backward-Euler step
+  // where it falls back); explicit: h times the force at the start of each substep. Set with
+  // has_impulse_a; EvaluateLead then reports end A's force as impulse_a over the advance.
   Vec3 impulse_a = Vec3::Zero();
+  bool has_impulse_a = false;
 };
 
 class Tether {
