@@ -561,16 +561,23 @@ int RunCli(const std::string& args, std::string* output) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+// The CLI on a BlueROV2 scene written to the test's temporary directory as `name`: its exit
+// code, and what it printed in *output.
+int RunCliOn(const std::string& command, const std::string& name, const std::string& EA,
+             const char* integrator, std::string* output) {
+  const std::string path = ::testing::TempDir() + "/" + name;
+  std::ofstream(path) << BlueRovXml(EA, integrator, 0.002);
+  return RunCli(command + " " + path, output);
+}
+
 TEST(CouplingCli, RefusalExitsWith2AndInfoPrintsEachLimit) {
-  const std::string path = ::testing::TempDir() + "/coupling_refused.xml";
-  std::ofstream(path) << BlueRovXml("1e7", "explicit", 0.002);
   std::string output;
-  EXPECT_EQ(RunCli("run " + path + " --duration 0.1", &output), 2) << output;
+  EXPECT_EQ(RunCliOn("run --duration 0.1", "coupling_refused.xml", "1e7", "explicit", &output),
+            2)
+      << output;
   EXPECT_TRUE(Contains(output, "omega h = ")) << output;
   EXPECT_TRUE(Contains(output, "use integrator=implicit or bdf2 (stable")) << output;
-  const std::string ok = ::testing::TempDir() + "/coupling_ok.xml";
-  std::ofstream(ok) << BlueRovXml("1e7", "implicit", 0.002);
-  EXPECT_EQ(RunCli("info " + ok, &output), 0) << output;
+  EXPECT_EQ(RunCliOn("info", "coupling_ok.xml", "1e7", "implicit", &output), 0) << output;
   EXPECT_TRUE(Contains(output, "stable step from: axial omega ")) << output;
   EXPECT_TRUE(Contains(output, "estimated cost ")) << output;
   EXPECT_TRUE(Contains(output, "coupling at end B (body 'rov'): k_end = EA/L0 = 1e+07 N/m"))
@@ -578,9 +585,7 @@ TEST(CouplingCli, RefusalExitsWith2AndInfoPrintsEachLimit) {
   // Which coupling the body gets: consistent at omega h 3.36 (>= kLeadFrom), held at 0.26.
   EXPECT_TRUE(Contains(output, "; consistent coupling (end node B solved with the body")) << output;
   EXPECT_TRUE(Contains(output, "; no limit")) << output;
-  const std::string held = ::testing::TempDir() + "/coupling_held.xml";
-  std::ofstream(held) << BlueRovXml("6e4", "implicit", 0.002);
-  EXPECT_EQ(RunCli("info " + held, &output), 0) << output;
+  EXPECT_EQ(RunCliOn("info", "coupling_held.xml", "6e4", "implicit", &output), 0) << output;
   EXPECT_TRUE(Contains(output, "; held end force; no limit for implicit")) << output;
 }
 
