@@ -5,15 +5,27 @@
   python3 tools/scene_fuzz_classify.py fuzz.log            # known-list lines, by class
   python3 tools/scene_fuzz_classify.py --counts fuzz.log   # outcome and class counts
 
+Outcomes are counted as the test printed them, with one exception: a log from before session
+11 (s11trans) printed a stretched start that disagreed, but whose same scene started
+unstretched agreed, as "FAIL disagrees ... started unstretched: agrees"; the test now gives it
+its own outcome, "pass warned: starts stretched, its outcome depends on the step as the warning
+says" (the warning was emitted: the test judged the stretch only where Attach warned), and this
+tool counts such old lines so too, marked "(old log)", whatever omega h is. A stretched start
+that disagrees also unstretched stays a failure in its class below.
+
+The test's passing outcomes include, since session 11 (s11trans), "agrees within a window moved
+by up to a tenth": a snap train whose snaps fall a few ms apart at 2 ms and at 0.2 ms, moving
+the 0.2 s mean beyond the tolerance (the test checks the position, the snap at the window's
+edge, and both references). A log from before counts such scenes as open-transient failures.
+
 Classes, first that applies (the labels of tests/scene_fuzz_known.txt):
   coupling          omega h >= 1 at the vehicle, omega = sqrt(EA / (L0 (m + a_min)))
   open-energy       the tether gains energy beyond the work of its ends (no current)
   open-one-two-segments   a tether of 1 or 2 segments
   open-thrust-qacc  MuJoCo's bad-qacc warning with a thrust scheduled
-  open-stretched-start  disagrees, started stretched (warned), and the same scene with the
-                    tether as long as the span agrees (the test judges it and says so)
+  open-stretched-start  (none since session 11: now the warned outcome above)
   open-transient    disagrees with the 0.2 ms run (and with the 0.02 ms run beyond the two
-                    refinements' spread; omega h < 1)
+                    refinements' spread, and not only by a snap's phase; omega h < 1)
   open-other        anything else (a bad qacc without thrust, a step blamed that 0.2 ms
                     does not cure)
 """
@@ -30,6 +42,16 @@ LINE = re.compile(r"^seed (\d+)( draw=(\d+))? \[(\w+), N=(\d+), EA=([^,]+), m=([
 LIMITS = {"explicit": "2", "rk4": "0.8", "implicit2": "none", "implicit": "none", "bdf2": "none"}
 CLASSES = ["coupling", "open-energy", "open-one-two-segments", "open-thrust-qacc",
            "open-stretched-start", "open-transient", "open-other"]
+
+
+WARNED = "warned: starts stretched, its outcome depends on the step as the warning says"
+
+
+def warned_stretched(passed, kind, detail):
+    """The test's warned outcome, or an old log's failure that the test now gives it."""
+    if passed:
+        return kind == WARNED
+    return kind.startswith("disagrees") and "started unstretched: agrees" in detail
 
 
 def classify(integ, n, omega_h, thrust, kind, detail=""):
@@ -66,6 +88,9 @@ def main():
         integ, n, ea, mass = m.group(4), int(m.group(5)), float(m.group(6)), float(m.group(7))
         omega_h, sb, thrust = float(m.group(8)), m.group(9), float(m.group(10))
         passed, kind, detail = m.group(11) == "pass", m.group(12), m.group(13)
+        if not passed and warned_stretched(passed, kind, detail):
+            outcomes["pass  " + WARNED + " (old log)"] += 1
+            continue
         outcomes[("pass  " if passed else "FAIL  ") + kind] += 1
         if passed:
             continue
