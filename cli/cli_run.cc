@@ -234,7 +234,11 @@ int Info(const std::string& path) {
     std::cout << "  tether '" << mjtether::TetherName(m, k) << "': " << p.segments
               << " segments of " << t->rest_segment_length() << " m, "
               << mjtether::IntegratorName(p.integrator)
-              << ", effects " << mjtether::EffectsToString(p.effects) << "\n"
+              << ", effects " << mjtether::EffectsToString(p.effects) << ", start "
+              << mjtether::StartName(p.start)
+              << (p.start == mjtether::Start::kStatic ? " (relaxed to static equilibrium)"
+                                                      : " (engine catenary, at rest)")
+              << "\n"
               << "    " << (p.integrator == mjtether::Integrator::kRK4 ? "rk4" : "explicit")
               << " stable step " << t->ExplicitStableStep() << " s; "
               << t->SubstepsFor(m->opt.timestep) << " tether step(s) per MuJoCo step\n";
