@@ -684,6 +684,14 @@ StaticResult Tether::RelaxToStatic(const Ends& ends, double* xp, double* vp, dou
   double h = g > 0 ? std::min(1.0, 0.1 * std::sqrt(L / g)) : 0.1;  // [s]
   Eigen::Matrix3Xd saved(3, n);
   Work w(work, N_);
+  // [N] the load the line carries: its net weight and the current's drag on all of it at
+  // rest, sum_i (|w_i| + kn |U|^2 l_i) (the residual's scale).
+  double load = 0;
+  for (int i = 0; i < n; ++i) {
+    const double U = Has(kCurrent) ? env_.water.MaxCurrentSpeed() : 0;
+    load += Weight(i).norm() + kn_ * U * U * Share(i);
+  }
+  result.load = load;
   // The largest net force on a dynamic node of x at rest [N], and that node.
   auto residual = [&](int* node) {
     v.setZero();
@@ -719,14 +727,15 @@ StaticResult Tether::RelaxToStatic(const Ends& ends, double* xp, double* vp, dou
     result.displacement = d;
     int node = -1;
     const double r_new = residual(&node);
-    if (h >= h_conv && d <= options.tolerance * L) {
+    if (h >= h_conv && d <= options.tolerance * L && r_new <= options.force_tolerance * load) {
       result.converged = true;
       break;
     }
     // Switched evolution relaxation: the step grows as the residual falls (at most x2, at
     // least x1/2 per step); a step that needed halvings does not grow.
-    const double ratio = r_new > 0 ? std::clamp(r / r_new, 0.5, 2.0) : 2.0;
-    if (s.halvings == 0 || ratio < 1) h = std::clamp(h * ratio, h_min, h_max);
+    // The step doubles after a step taken whole and halves after one the implicit step had to
+    // split (ImplicitStepAdaptive).
+    h = std::clamp(s.halvings == 0 ? 2 * h : 0.5 * h, h_min, h_max);
     r = r_new;
   }
   v.setZero();

@@ -112,6 +112,9 @@ struct StaticOptions {
   // [-] converged when the largest node displacement of one pseudo-time step is below
   // tolerance x the tether's length (at the largest pseudo-time step, see tether.cc)
   double tolerance = 1e-8;
+  // [-] and the largest net force on a node of the shape at rest is below force_tolerance x the
+  // load (the net weight and the current's drag at rest, summed over the nodes)
+  double force_tolerance = 1e-3;
 };
 struct StaticResult {
   bool converged = false;  // the displacement fell below the tolerance
@@ -119,6 +122,7 @@ struct StaticResult {
   int iterations = 0;      // [-] pseudo-time steps taken
   double displacement = 0;  // [m] largest node displacement of the last step
   double residual = 0;      // [N] largest net force on a dynamic node of the final shape at rest
+  double load = 0;          // [N] the scale of force_tolerance (StaticOptions)
   int node = -1;            // [-] that node
   double final_step = 0;    // [s] the last pseudo-time step
   std::string reason;       // why the shape is unusable (!ok)
