@@ -115,6 +115,7 @@ struct AttachedTether {
   // ends it holds, computed at load; a restart with the ends at the same places copies it,
   // any other relaxes again (StartShape).
   std::vector<double> static_x;
+  StaticResult static_result;  // how the load-time relaxation went
   Vec3 static_a = Vec3::Zero(), static_b = Vec3::Zero();
 };
 
@@ -1149,6 +1150,7 @@ bool StaticStartAtLoad(const mjModel* m, const mjData* d, AttachedTether* at,
       << "; starting from the last shape, which is not at rest: expect a start transient";
     *warning = s.str();
   }
+  at->static_result = r;
   at->static_x = std::move(x);
   at->static_a = ends.a.pos;
   at->static_b = ends.b.pos;
@@ -1807,6 +1809,12 @@ CouplingLimit GetCouplingLimit(const mjModel* m, int k, int end) {
     return {};
   }
   return set->tethers[k].limit[end];
+}
+
+StaticResult GetStaticStart(const mjModel* m, int k) {
+  const ModelTethers* set = Lookup(m);
+  if (!set || k < 0 || k >= static_cast<int>(set->tethers.size())) return {};
+  return set->tethers[k].static_result;
 }
 
 double EstimatedCostPerSecond(const Tether& t, double timestep) {

@@ -108,7 +108,7 @@ struct StepStatus {
 
 // Options and outcome of Tether::RelaxToStatic (docs/static_start.md).
 struct StaticOptions {
-  int max_iterations = 400;  // [-] pseudo-time steps at most
+  int max_iterations = 1000;  // [-] pseudo-time steps at most
   // [-] converged when the largest node displacement of one pseudo-time step is below
   // tolerance x the tether's length (at the largest pseudo-time step, see tether.cc)
   double tolerance = 1e-8;
