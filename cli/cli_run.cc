@@ -234,10 +234,21 @@ int Info(const std::string& path) {
     std::cout << "  tether '" << mjtether::TetherName(m, k) << "': " << p.segments
               << " segments of " << t->rest_segment_length() << " m, "
               << mjtether::IntegratorName(p.integrator)
-              << ", effects " << mjtether::EffectsToString(p.effects) << "\n"
+              << ", effects " << mjtether::EffectsToString(p.effects) << ", start "
+              << mjtether::StartName(p.start)
+              << (p.start == mjtether::Start::kStatic ? " (relaxed to static equilibrium)"
+                                                      : " (engine catenary, at rest)")
+              << "\n"
               << "    " << (p.integrator == mjtether::Integrator::kRK4 ? "rk4" : "explicit")
               << " stable step " << t->ExplicitStableStep() << " s; "
               << t->SubstepsFor(m->opt.timestep) << " tether step(s) per MuJoCo step\n";
+    if (p.start == mjtether::Start::kStatic) {
+      const mjtether::StaticResult r = mjtether::GetStaticStart(m, k);
+      std::cout << "    static start: " << (r.converged ? "converged" : "NOT converged") << " in "
+                << r.iterations << " pseudo step(s), last displacement " << r.displacement
+                << " m, largest residual force " << r.residual << " N at node " << r.node
+                << " (load " << r.load << " N), last pseudo step " << r.final_step << " s\n";
+    }
     // The time-step advisor's limits, each on its own line (docs/coupling.md).
     const mjtether::Tether::StabilityTerms& st = t->stability_terms();
     std::cout << "    stable step from: axial omega " << st.w_axial << " rad/s";

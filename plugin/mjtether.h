@@ -76,6 +76,9 @@ struct CouplingLimit {
   bool consistent = false;
 };
 CouplingLimit GetCouplingLimit(const mjModel* m, int k, int end);
+// How the static start of tether k went at load (start=static; docs/static_start.md): pseudo
+// steps, last displacement, residual force and its node; iterations 0 for start=catenary.
+StaticResult GetStaticStart(const mjModel* m, int k);
 // An explicit or rk4 tether on a body whose coupling frequency gives omega h at or above this
 // is refused at load, and warned about above half of it (docs/coupling.md). explicit: on the
 // BlueROV2 case the 1% agreement with a 0.1 ms reference is lost between omega h = 2.1 and

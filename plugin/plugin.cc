@@ -111,7 +111,35 @@ struct AttachedTether {
   int actuator = -1;               // whose ctrl commands it
   double initial_length = 0;       // [m] deployed at the start (the tether's `length`)
   int winch_offset = 0;            // start of the winch slots in userdata
+  // start=static (docs/static_start.md): the relaxed shape at qpos0 (x, 3 x nodes) and the
+  // ends it holds, computed at load; a restart with the ends at the same places copies it,
+  // any other relaxes again (StartShape).
+  std::vector<double> static_x;
+  StaticResult static_result;  // how the load-time relaxation went
+  Vec3 static_a = Vec3::Zero(), static_b = Vec3::Zero();
 };
+
+// The start shape at a restart: the initial shape (Tether::InitialShape), and with
+// start=static that shape relaxed to static equilibrium with the ends held (the load-time
+// shape when the ends are where they were at load). Velocities: zero inside, the sites' at
+// the ends. `work`: WorkspaceSize() doubles.
+void StartShape(const AttachedTether& at, const Tether& tether, const Ends& now, double* x,
+                double* v, double* work) {
+  tether.InitialShape(now, x, v);
+  if (tether.params().start != Start::kStatic) return;
+  const bool free_end = at.site[1] < 0;
+  if (!at.static_x.empty() && now.a.pos == at.static_a &&
+      (free_end || now.b.pos == at.static_b)) {
+    std::copy(at.static_x.begin(), at.static_x.end(), x);
+    return;
+  }
+  Ends held = now;
+  held.contacts = nullptr;
+  held.body_b = nullptr;
+  if (!at.tether.RelaxToStatic(held, x, v, work).ok) {
+    tether.InitialShape(now, x, v);  // unusable (load refused it at qpos0): the catenary
+  }
+}
 
 // The deployed unstretched length [m]: the winch's, else the declared length.
 double DeployedLength(const AttachedTether& at, const double* u) {
@@ -371,7 +399,7 @@ void EvaluateLead(const mjModel* m, mjData* d, const AttachedTether& at, double*
   if (!restart && d->time == u[kTime]) return apply();  // the same step again
   const double h = m->opt.timestep;
   if (restart) {
-    tether.InitialShape(now, x.data(), v.data());
+    StartShape(at, tether, now, x.data(), v.data(), work);
     if (history) history[0] = 0;
     RecordStart(u, now, d->time,
                 std::max(0.0, (now.b.pos - now.a.pos).norm() / tether.params().length - 1));
@@ -485,7 +513,7 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
         }
       }
     } else {
-      tether.InitialShape(now, x, v);
+      StartShape(at, tether, now, x, v, work);
     }
     // bdf2 starts again with a backward-Euler step (no history yet).
     if (history) history[0] = 0;
@@ -1076,6 +1104,59 @@ bool CheckStart(const mjModel* m, const mjData* d, const Environment& env,
   return true;
 }
 
+// The iteration cap of the static start: StaticOptions' unless the test hook
+// MJTETHER_STATIC_MAX_ITERATIONS gives another (tests/static_start_test.cc, non-convergence).
+StaticOptions StaticStartOptions() {
+  StaticOptions o;
+  if (const char* cap = std::getenv("MJTETHER_STATIC_MAX_ITERATIONS")) {
+    o.max_iterations = std::max(1, std::atoi(cap));
+  }
+  return o;
+}
+
+// start=static at load: relaxes the initial shape at qpos0 (the kinematics in d) to static
+// equilibrium and keeps it for the restarts (AttachedTether::static_x). Not converged within
+// the cap: a warning naming the tether, the residual force and its node, the last shape kept.
+// A shape that is not usable (non-finite, strain beyond max_strain): refused (exit 2).
+bool StaticStartAtLoad(const mjModel* m, const mjData* d, AttachedTether* at,
+                       std::string* warning, std::string* error) {
+  warning->clear();
+  const Tether& t = at->tether;
+  Ends ends;
+  for (int end = 0; end < 2; ++end) {
+    if (at->site[end] < 0) continue;
+    EndState& e = end == 0 ? ends.a : ends.b;
+    e.pos = Vec3(d->site_xpos + 3 * at->site[end]);
+    const double* R = d->site_xmat + 9 * at->site[end];
+    e.axis = Vec3(R[0], R[3], R[6]);
+  }
+  std::vector<double> x(3 * t.nodes()), v(3 * t.nodes()), work(t.WorkspaceSize());
+  t.InitialShape(ends, x.data(), v.data());
+  const StaticResult r = t.RelaxToStatic(ends, x.data(), v.data(), work.data(),
+                                         StaticStartOptions());
+  std::ostringstream s;
+  if (!r.ok) {
+    s << "key 'start' = static: the relaxation to static equilibrium left an unusable shape ("
+      << r.reason << ", node " << r.node << " of " << t.segments()
+      << "): use start=catenary, or check the ends, length and loads";
+    *error = s.str();
+    return false;
+  }
+  if (!r.converged) {
+    s << "key 'start' = static: not converged to static equilibrium in " << r.iterations
+      << " iterations (the last moved a node by " << r.displacement << " m, tolerance "
+      << StaticOptions().tolerance * t.params().length << " m); largest residual force "
+      << r.residual << " N at node " << r.node << " of " << t.segments()
+      << "; starting from the last shape, which is not at rest: expect a start transient";
+    *warning = s.str();
+  }
+  at->static_result = r;
+  at->static_x = std::move(x);
+  at->static_a = ends.a.pos;
+  at->static_b = ends.b.pos;
+  return true;
+}
+
 // Vehicles (vehicle:BODY texts) whose body starts below the seabed.
 bool CheckVehicles(const mjModel* m, const mjData* d, const Environment& env,
                    std::string* element, std::string* error) {
@@ -1558,6 +1639,13 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
                                 "declare the vehicle (README, Vehicles)");
       }
     }
+    if (tether->params().start == Start::kStatic && (at.contact || at.winch)) {
+      // The relaxation holds the ends and steps the tether alone: the contact candidates come
+      // from MuJoCo's geoms at each step, and a winch changes the deployed length.
+      return fail(name, std::string("key 'start' = static is not supported with ") +
+                            (at.contact ? "key 'contact'" : "a winch") +
+                            " yet (docs/static_start.md): use start=catenary (the default)");
+    }
     if (at.contact) {
       std::vector<std::string> notes;
       if (!ResolveContactGeoms(m, decl->contact, at.site, *tether, &at.contacts, &notes,
@@ -1589,7 +1677,7 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
     mj_kinematics(m, scratch);
     std::string message, element;
     bool ok = true;
-    for (const AttachedTether& at : set->tethers) {
+    for (AttachedTether& at : set->tethers) {
       std::string warning;
       if (!CheckStart(m, scratch, env, at, &warning, &message)) {
         element = "tether:" + at.name;
@@ -1597,6 +1685,15 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
         break;
       }
       if (!warning.empty()) {
+        set->warnings.push_back(source + ": <text name=\"tether:" + at.name + "\">: " + warning);
+      }
+      if (at.tether.params().start == Start::kStatic &&
+          !StaticStartAtLoad(m, scratch, &at, &warning, &message)) {
+        element = "tether:" + at.name;
+        ok = false;
+        break;
+      }
+      if (!warning.empty() && at.tether.params().start == Start::kStatic) {
         set->warnings.push_back(source + ": <text name=\"tether:" + at.name + "\">: " + warning);
       }
     }
@@ -1712,6 +1809,12 @@ CouplingLimit GetCouplingLimit(const mjModel* m, int k, int end) {
     return {};
   }
   return set->tethers[k].limit[end];
+}
+
+StaticResult GetStaticStart(const mjModel* m, int k) {
+  const ModelTethers* set = Lookup(m);
+  if (!set || k < 0 || k >= static_cast<int>(set->tethers.size())) return {};
+  return set->tethers[k].static_result;
 }
 
 double EstimatedCostPerSecond(const Tether& t, double timestep) {

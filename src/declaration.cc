@@ -311,7 +311,7 @@ std::optional<TetherDeclaration> ParseTether(const std::string& text, const Envi
       "EI",      "damping", "Cdn",       "Cdt",      "Can",             "integrator",
       "clamp",   "effects", "substeps",  "max_step", "max_strain", "bending",
       "EAc",     "contact", "contact_stiffness", "contact_damping", "contact_friction",
-      "contact_friction_speed"};
+      "contact_friction_speed", "start"};
   static const char* const kRequired[] = {"ends",     "length",          "segments",
                                           "diameter", "mass_per_length", "EA"};
   std::optional<KeyValues> pairs = SplitKeyValues(text, error);
@@ -374,6 +374,15 @@ std::optional<TetherDeclaration> ParseTether(const std::string& text, const Envi
         ok = Fail(error, key,
                   "key 'integrator' = " + Shown(value) +
                       "; allowed: bdf2 (default), implicit, implicit2, explicit, rk4");
+      }
+    } else if (key == "start") {
+      if (value == "catenary") {
+        p.start = Start::kCatenary;
+      } else if (value == "static") {
+        p.start = Start::kStatic;
+      } else {
+        ok = Fail(error, key,
+                  "key 'start' = " + Shown(value) + "; allowed: catenary (default), static");
       }
     } else if (key == "bending") {
       if (value == "galerkin") {

@@ -70,6 +70,13 @@ inline const char* IntegratorName(Integrator i) {
   return "?";
 }
 
+// How a tether starts (key `start`; docs/static_start.md).
+enum class Start {
+  kCatenary,  // the engine's initial shape (Tether::InitialShape), at rest: the default
+  kStatic,    // that shape relaxed to static equilibrium (Tether::RelaxToStatic), at rest
+};
+inline const char* StartName(Start s) { return s == Start::kStatic ? "static" : "catenary"; }
+
 // The water a tether is in (declared by <text name="water">). Absent: a dry scene.
 struct Water {
   double density = 1025;         // [kg/m^3]
@@ -133,6 +140,7 @@ struct TetherParams {
   // for the longest deployment and length = segments x L0; the explicit stability limit is
   // taken at the shortest viable winch segment, L0/2.
   bool winch = false;
+  Start start = Start::kCatenary;  // key `start` (catenary | static)
 };
 
 // Everything a Tether needs from its surroundings.

@@ -637,3 +637,124 @@ bool Tether::RestOnLevel(const Ends& ends, double zb, Nodes x) const {
 }
 
 }  // namespace mjtether
+
+namespace mjtether {
+using namespace detail;
+
+// ---------------------------------------------------------------------------------------------
+// Static start
+
+// Pseudo-transient continuation (Kelley & Keyes, SIAM J. Numer. Anal. 35, 1998) on the nodal
+// equilibrium f(x, 0) = 0 (f: every force on a node of the still tether: weight, buoyancy,
+// EA/EAc/EI, the current's drag on v = 0, the seabed). Each iteration is one backward-Euler
+// step of the implicit integrator (ImplicitStepAdaptive, with its Newton iteration, line
+// search and halvings) from rest,
+//   M (v+ - 0) = h f(x + h v+, v+),   x+ = x + h v+,
+// after which v is reset to zero: (M/h^2 + K + C/h) dx = f(x) to first order (K the stiffness,
+// C the damping and drag derivatives), a Newton step on f = 0 regularised by the mass. Small h:
+// a damped descent (each step moves a node by h^2 f/m); large h: Newton's method. The pseudo
+// step h grows by 2 after every step that succeeded without halving or stall and whose largest
+// displacement did not grow, and falls by 4 otherwise (a step that failed is undone), between
+// h_min = 1e-4 s and h_max = 1e4 s. Converged when, at a pseudo step of at least
+// h_conv = 10 sqrt(L/g) (ten times the pendulum time of the whole line, so that the mass term
+// M/h^2 is at most 1% of the geometric stiffness of a hanging line), the largest displacement of
+// a step is below tolerance x L: with h that large, the step is the Newton correction, so the
+// displacement is the distance to equilibrium. A fixed point x+ = x has v+ = 0 and so
+// f(x, 0) = 0 exactly: the relaxation changes nothing but the start.
+StaticResult Tether::RelaxToStatic(const Ends& ends, double* xp, double* vp, double* work,
+                                   const StaticOptions& options) const {
+  const int n = N_ + 1;
+  Nodes x(xp, 3, n), v(vp, 3, n);
+  StaticResult result;
+  Tether t = *this;
+  t.p_.integrator = Integrator::kImplicit;
+  t.p_.substeps = 0;
+  t.p_.max_step = 0;
+  t.dynamic_b_ = false;
+  Ends held = ends;
+  held.a.vel.setZero();
+  held.b.vel.setZero();
+  held.time = 0;
+  held.contacts = nullptr;
+  held.body_b = nullptr;
+  const double g = env_.gravity.norm();
+  const double L = p_.length;
+  const double h_min = 1e-4, h_max = 1e4;  // [s]
+  const double h_conv = g > 0 ? std::min(h_max, 10 * std::sqrt(L / g)) : 10.0;  // [s]
+  double h = g > 0 ? std::min(1.0, 0.1 * std::sqrt(L / g)) : 0.1;  // [s]
+  Eigen::Matrix3Xd saved(3, n);
+  Work w(work, N_);
+  // [N] the load the line carries: its net weight and the current's drag on all of it at
+  // rest, sum_i (|w_i| + kn |U|^2 l_i) (the residual's scale).
+  double load = 0;
+  for (int i = 0; i < n; ++i) {
+    const double U = Has(kCurrent) ? env_.water.MaxCurrentSpeed() : 0;
+    load += Weight(i).norm() + kn_ * U * U * Share(i);
+  }
+  result.load = load;
+  // The largest net force on a dynamic node of x at rest [N], and that node.
+  auto residual = [&](int* node) {
+    v.setZero();
+    t.PlaceEnds(held, x, v);
+    t.ComputeForces(xp, vp, held, w.f, nullptr, work);
+    const ConstNodes f(w.f, 3, n);
+    double r = 0;
+    for (int i = 0; i < n; ++i) {
+      if (!t.Dynamic(i)) continue;
+      const double fi = f.col(i).norm();
+      if (!(fi <= r)) r = fi, *node = i;
+    }
+    return r;
+  };
+  double r = residual(&result.node);
+  for (int it = 0; it < options.max_iterations; ++it) {
+    result.iterations = it + 1;
+    saved = x;
+    v.setZero();
+    const StepStatus s = t.Advance(xp, vp, held, held, h, work);
+    const double d = (x - saved).colwise().norm().maxCoeff();  // [m]
+    result.final_step = h;
+    if (!s.ok || s.stalled_steps > 0 || !std::isfinite(d)) {
+      x = saved;  // undo
+      if (h <= h_min) {
+        result.ok = s.ok;
+        result.reason = s.ok ? "" : s.reason;
+        break;
+      }
+      h = std::max(h_min, h / 4);
+      continue;
+    }
+    result.displacement = d;
+    int node = -1;
+    const double r_new = residual(&node);
+    // (A residual a thousand times below the force tolerance is equilibrium at any pseudo step.)
+    if (d <= options.tolerance * L && r_new <= options.force_tolerance * load &&
+        (h >= h_conv || r_new <= 1e-3 * options.force_tolerance * load)) {
+      result.converged = true;
+      break;
+    }
+    // Switched evolution relaxation: the step grows as the residual falls (at most x2, at
+    // least x1/2 per step); a step that needed halvings does not grow.
+    // The step doubles after a step taken whole and halves after one the implicit step had to
+    // split (ImplicitStepAdaptive).
+    h = std::clamp(s.halvings == 0 ? 2 * h : 0.5 * h, h_min, h_max);
+    r = r_new;
+  }
+  v.setZero();
+  t.PlaceEnds(held, x, v);
+  result.residual = residual(&result.node);
+  if (result.ok) {
+    StepStatus check;
+    t.Check(ConstNodes(xp, 3, n), ConstNodes(vp, 3, n), held, held, &check);
+    if (!check.ok) {
+      result.ok = false;
+      result.reason = check.reason;
+      result.node = check.node;
+    }
+  }
+  v.col(0) = ends.a.vel;
+  if (!p_.free_end) v.col(N_) = ends.b.vel;
+  return result;
+}
+
+}  // namespace mjtether

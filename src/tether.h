@@ -106,6 +106,28 @@ struct StepStatus {
   bool has_impulse_a = false;
 };
 
+// Options and outcome of Tether::RelaxToStatic (docs/static_start.md).
+struct StaticOptions {
+  int max_iterations = 1000;  // [-] pseudo-time steps at most
+  // [-] converged when the largest node displacement of one pseudo-time step is below
+  // tolerance x the tether's length (at the largest pseudo-time step, see tether.cc)
+  double tolerance = 1e-8;
+  // [-] and the largest net force on a node of the shape at rest is below force_tolerance x the
+  // load (the net weight and the current's drag at rest, summed over the nodes)
+  double force_tolerance = 1e-3;
+};
+struct StaticResult {
+  bool converged = false;  // the displacement fell below the tolerance
+  bool ok = true;          // the shape is usable: finite, within max_strain (else *reason)
+  int iterations = 0;      // [-] pseudo-time steps taken
+  double displacement = 0;  // [m] largest node displacement of the last step
+  double residual = 0;      // [N] largest net force on a dynamic node of the final shape at rest
+  double load = 0;          // [N] the scale of force_tolerance (StaticOptions)
+  int node = -1;            // [-] that node
+  double final_step = 0;    // [s] the last pseudo-time step
+  std::string reason;       // why the shape is unusable (!ok)
+};
+
 class Tether {
  public:
   // Precomputes masses, coefficients and the explicit stability limit. Returns nothing (and
@@ -152,6 +174,16 @@ class Tether {
   // end down to it and lays the rest of its length on it (see RestOnSeabed): no node starts
   // below the seabed. Velocities: zero inside, the sites' at the ends.
   void InitialShape(const Ends& ends, double* x, double* v) const;
+
+  // Relaxes the state x (3 x (N+1), e.g. from InitialShape) to static equilibrium with the
+  // attached ends held at ends.a.pos, ends.b.pos (a free end B moves): weight, buoyancy, the
+  // current's drag on the still tether, EA/EAc/EI and the seabed (contact, friction), by
+  // pseudo-transient continuation (backward-Euler steps of a growing pseudo-time step with the
+  // velocities reset to zero after each; tether.cc). On return v is zero inside and the
+  // sites' velocities at the ends. Without contact (Ends::contacts) and winch; `work` is
+  // WorkspaceSize() doubles. Allocates (a load-time call).
+  StaticResult RelaxToStatic(const Ends& ends, double* x, double* v, double* work,
+                             const StaticOptions& options = {}) const;
 
   // Doubles of integrator history a state carries besides x and v: with integrator=bdf2, the
   // last step h_prev [s] (0: none yet) and the last step's change of x and v (3 x (N+1) each),

@@ -56,7 +56,8 @@
 // Environment: MJTETHER_SCENE_FUZZ_COUNT (default 200), MJTETHER_SCENE_FUZZ_FIRST (first
 // seed, default 1), MJTETHER_SCENE_FUZZ_THREADS (default 2), MJTETHER_SCENE_FUZZ_VERBOSE=1
 // (one line per scene, flushed), MJTETHER_SCENE_FUZZ_XML=1 (print each scene's MJCF instead of
-// running it), MJTETHER_SCENE_FUZZ_SEEDS=a,b,c (only these seeds; "372d1": seed 372 of draw 1).
+// running it), MJTETHER_SCENE_FUZZ_SEEDS=a,b,c (only these seeds; "372d1": seed 372 of draw 1),
+// MJTETHER_SCENE_FUZZ_START=static (every scene declares start=static; docs/static_start.md).
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
 
@@ -289,6 +290,10 @@ Scene Make(unsigned long long seed, int draw = kDraw) {
     << " EA=" << s.EA << " Cdn=1.2 Cdt=0.01 Can=1 integrator=" << s.integrator;
   if (s.EI > 0) x << " EI=" << s.EI << " EAc=" << s.EA;
   if (s.damping > 0) x << " damping=" << s.damping;
+  // MJTETHER_SCENE_FUZZ_START=static: every scene with start=static (docs/static_start.md).
+  if (const char* start = std::getenv("MJTETHER_SCENE_FUZZ_START"); start && *start) {
+    x << " start=" << start;
+  }
   x << "\"/>\n";
   if (s.motion_amp > 0) {
     x << "<text name=\"motion:tms\" data=\""
