@@ -242,11 +242,14 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   const double h2 = h * h;
   const bool added = Has(kAddedMass);
   Start start{ConstNodes(x.data(), 3, n), h, false};
+  // [kg] the smallest mass end node B moves with beyond its own (EndInertia::min_mass: when
+  // the node's inertia was taken out of body->mass, the body's alone, less the node's mass).
   const double body_min_mass =
-      body ? Eigen::SelfAdjointEigenSolver<Mat3>(body->mass, Eigen::EigenvaluesOnly)
-                 .eigenvalues()
-                 .minCoeff()
-           : 0;  // [kg]
+      !body                ? 0
+      : body->min_mass > 0 ? body->min_mass - Mass(N_)
+                           : Eigen::SelfAdjointEigenSolver<Mat3>(body->mass, Eigen::EigenvaluesOnly)
+                                 .eigenvalues()
+                                 .minCoeff();
 
   // Forces at the iterate, and the residual -G = h f - M (v+ - v) (node mass with normal added
   // mass) into rhs. Returns phi*2 and, in *err, the largest |G_i|/m_i [m/s].
