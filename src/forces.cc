@@ -499,12 +499,6 @@ EndReactions Tether::Reactions(const double* xp, const double* vp, const Ends& e
   return r;
 }
 
-Mat3 Tether::NodeInertia(int i, const Vec3& q) const {
-  Mat3 M = Mass(i) * Mat3::Identity();
-  if (Has(kAddedMass)) M += Added(i) * (Mat3::Identity() - q * q.transpose());
-  return M;
-}
-
 double Tether::EndStiffness() const {
   return (Has(kCompression) ? std::max(p_.EA, p_.EAc) : p_.EA) / L0_;
 }

@@ -43,14 +43,14 @@ struct EndState {
 // coupling): with it, a tether made by Tether::WithDynamicEndB() steps its end node B as a
 // dynamic node carrying the body's effective mass W^-1 besides its own, under the force
 // W^-1 a_other that gives the site the acceleration a_other it has without the tether.
-// EvaluateLead gives mass = W^-1 minus end node B's own inertia (Tether::NodeInertia at the
-// step's start), so that the node and the body move as the body's mass alone, as the held force
-// has them (docs/coupling.md, "session 11, s11coup"); min_mass is then the smallest eigenvalue
-// of W^-1, the mass the node moves with (0: take it from mass plus the node's).
+// node_inertia false (EvaluateLead with the implicit schemes): end node B's own inertia (mass,
+// normal added mass) is left out of its step, so that the node and the body move as the body's
+// mass alone, as the held force has them (docs/coupling.md, "session 11, s11coup"); its forces
+// (segment, weight, drag) stay.
 struct EndInertia {
-  Eigen::Matrix3d mass = Eigen::Matrix3d::Zero();  // [kg] W^-1 (less the node's inertia)
+  Eigen::Matrix3d mass = Eigen::Matrix3d::Zero();  // [kg] W^-1
   Vec3 force = Vec3::Zero();                       // [N] W^-1 a_other
-  double min_mass = 0;                             // [kg] see above
+  bool node_inertia = true;
 };
 
 struct Ends {
@@ -211,9 +211,9 @@ class Tether {
   // [J] (see tether.cc); Advance reports a kinetic energy above 10 times this as divergence.
   double EnergyBound(const Ends& from, const Ends& to) const;
 
-  // The inertia node i moves with [kg]: its mass and, with added mass, the normal added mass
-  // across the unit tangent q, m_i I + ma_i (I - q q^T) (the mass block of the implicit step).
-  Eigen::Matrix3d NodeInertia(int i, const Vec3& q) const;
+  // The largest inertia node i moves with along any direction [kg]: its mass plus, with added
+  // mass, its normal added mass.
+  double NodeInertiaMax(int i) const { return Mass(i) + (Has(kAddedMass) ? Added(i) : 0.0); }
 
   // Stiffness the end segment presents to a site [N/m]: k_end = EA/L0 (the larger of EA and
   // EAc when compressed segments push back). The time-step advisor's coupling frequency at an
