@@ -247,6 +247,9 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
                  .eigenvalues()
                  .minCoeff()
            : 0;  // [kg]
+  // End node B's own inertia in its row (EndInertia::node_inertia): without it the node moves
+  // with the body's mass alone.
+  const bool node_b_mass = !body || body->node_inertia;
 
   // Forces at the iterate, and the residual -G = h f - M (v+ - v) (node mass with normal added
   // mass) into rhs. Returns phi*2 and, in *err, the largest |G_i|/m_i [m/s].
@@ -258,8 +261,9 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
       // (End node B of an implicit2 mixed stage: its mass scaled by cN, above.)
       const Vec3 dvi =
           i == N_ && cN != 1 ? Vec3(cN * (vk.col(i) - v.col(i))) : Vec3(vk.col(i) - v.col(i));
-      Vec3 r = step(i) * f.col(i) - Mass(i) * dvi;
-      if (added) {
+      const bool own = i != N_ || node_b_mass;
+      Vec3 r = step(i) * f.col(i) - (own ? Mass(i) : 0.0) * dvi;
+      if (added && own) {
         const Vec3 qi = q.col(i);
         r -= Added(i) * (dvi - qi.dot(dvi) * qi);
       }
@@ -268,7 +272,7 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         // The body's share: (W^-1 + m) dv = h (f + W^-1 a_other); G weighted by the inverse
         // of the smallest total mass along a direction.
         r += hN * body->force - body->mass * dvi;
-        inv = 1 / (cN * (Mass(i) + body_min_mass));
+        inv = 1 / (cN * ((own ? Mass(i) : 0.0) + body_min_mass));
       }
       rhs.col(i - 1) = r;
       const double r2 = r.squaredNorm();
@@ -320,6 +324,7 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
         d[0] = m, d[1] = 0, d[2] = 0, d[4] = m, d[5] = 0, d[8] = m;
       }
       if (body && i == N_) {
+        if (!node_b_mass) d[0] = d[1] = d[2] = d[4] = d[5] = d[8] = 0;
         for (int e = 0; e < 6; ++e) d[kLowK[e]] += body->mass.data()[kLowK[e]];
         if (cN != 1) {
           for (int e = 0; e < 6; ++e) d[kLowK[e]] *= cN;

@@ -43,9 +43,14 @@ struct EndState {
 // coupling): with it, a tether made by Tether::WithDynamicEndB() steps its end node B as a
 // dynamic node carrying the body's effective mass W^-1 besides its own, under the force
 // W^-1 a_other that gives the site the acceleration a_other it has without the tether.
+// node_inertia false (EvaluateLead with the implicit schemes): end node B's own inertia (mass,
+// normal added mass) is left out of its step, so that the node and the body move as the body's
+// mass alone, as the held force has them (docs/coupling.md, "session 11, s11coup"); its forces
+// (segment, weight, drag) stay.
 struct EndInertia {
   Eigen::Matrix3d mass = Eigen::Matrix3d::Zero();  // [kg] W^-1
   Vec3 force = Vec3::Zero();                       // [N] W^-1 a_other
+  bool node_inertia = true;
 };
 
 struct Ends {
@@ -237,6 +242,10 @@ class Tether {
   // The most energy the tether can hold physically while its ends move from `from` to `to`
   // [J] (see tether.cc); Advance reports a kinetic energy above 10 times this as divergence.
   double EnergyBound(const Ends& from, const Ends& to) const;
+
+  // The largest inertia node i moves with along any direction [kg]: its mass plus, with added
+  // mass, its normal added mass.
+  double NodeInertiaMax(int i) const { return Mass(i) + (Has(kAddedMass) ? Added(i) : 0.0); }
 
   // Stiffness the end segment presents to a site [N/m]: k_end = EA/L0 (the larger of EA and
   // EAc when compressed segments push back). The time-step advisor's coupling frequency at an
