@@ -1134,7 +1134,7 @@ StaticOptions StaticStartOptions() {
 // equilibrium and keeps it for the restarts (AttachedTether::static_x). Not converged within
 // the cap: a warning naming the tether, the residual force and its node, the last shape kept.
 // A shape that is not usable (non-finite, strain beyond max_strain): refused (exit 2).
-bool StaticStartAtLoad(const mjModel* m, const mjData* d, AttachedTether* at,
+bool StaticStartAtLoad(const mjModel* /*m*/, const mjData* d, AttachedTether* at,
                        std::string* warning, std::string* error) {
   warning->clear();
   const Tether& t = at->tether;

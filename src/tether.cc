@@ -706,7 +706,7 @@ StaticResult Tether::RelaxToStatic(const Ends& ends, double* xp, double* vp, dou
     }
     return r;
   };
-  double r = residual(&result.node);
+  residual(&result.node);  // the node to name if the first step fails
   for (int it = 0; it < options.max_iterations; ++it) {
     result.iterations = it + 1;
     saved = x;
@@ -733,12 +733,9 @@ StaticResult Tether::RelaxToStatic(const Ends& ends, double* xp, double* vp, dou
       result.converged = true;
       break;
     }
-    // Switched evolution relaxation: the step grows as the residual falls (at most x2, at
-    // least x1/2 per step); a step that needed halvings does not grow.
     // The step doubles after a step taken whole and halves after one the implicit step had to
     // split (ImplicitStepAdaptive).
     h = std::clamp(s.halvings == 0 ? 2 * h : 0.5 * h, h_min, h_max);
-    r = r_new;
   }
   v.setZero();
   t.PlaceEnds(held, x, v);
