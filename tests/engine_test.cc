@@ -10,42 +10,12 @@
 #include "band_cholesky.h"
 #include "catenary_reference.h"
 #include "declaration.h"
+#include "engine_sim.h"
 #include "make_tether.h"
 #include "tether.h"
 
 namespace mjtether {
 namespace {
-
-// A tether with its state and workspace, for tests.
-struct Sim {
-  Tether tether;
-  std::vector<double> x, v, work;
-  Ends ends;
-  explicit Sim(const Tether& t)
-      : tether(t), x(3 * t.nodes()), v(3 * t.nodes()), work(t.WorkspaceSize()) {}
-  void Init() { tether.InitialShape(ends, x.data(), v.data()); }
-  StepStatus Step(double dt) {
-    return tether.Advance(x.data(), v.data(), ends, ends, dt, work.data());
-  }
-  Vec3 node(int i) const { return Vec3(x[3 * i], x[3 * i + 1], x[3 * i + 2]); }
-  double Energy() const {
-    return tether.KineticEnergy(x.data(), v.data()) + tether.PotentialEnergy(x.data(), ends);
-  }
-  EndReactions Reactions() { return tether.Reactions(x.data(), v.data(), ends, work.data()); }
-};
-
-
-TetherParams CatenaryParams(int segments) {
-  TetherParams p;
-  p.length = 100;
-  p.segments = segments;
-  p.diameter = 0.02;
-  p.mass_per_length = 1.0;
-  p.EA = 1e5;  // strain about 1% at the ~1 kN tensions below: elasticity matters
-  p.damping = 2e3;
-  p.integrator = Integrator::kImplicit;
-  return p;
-}
 
 // ---------------------------------------------------------------------------------------------
 

@@ -12,41 +12,13 @@
 
 #include "catenary_reference.h"
 #include "declaration.h"
+#include "engine_sim.h"
 #include "make_tether.h"
 #include "mujoco_fixture.h"
 #include "tether.h"
 
 namespace mjtether {
 namespace {
-
-struct Sim {
-  Tether tether;
-  std::vector<double> x, v, work;
-  Ends ends;
-  explicit Sim(const Tether& t)
-      : tether(t), x(3 * t.nodes()), v(3 * t.nodes()), work(t.WorkspaceSize()) {}
-  void Init() { tether.InitialShape(ends, x.data(), v.data()); }
-  StaticResult Relax(const StaticOptions& o = {}) {
-    return tether.RelaxToStatic(ends, x.data(), v.data(), work.data(), o);
-  }
-  StepStatus Step(double dt) {
-    return tether.Advance(x.data(), v.data(), ends, ends, dt, work.data());
-  }
-  Vec3 node(int i) const { return Vec3(x[3 * i], x[3 * i + 1], x[3 * i + 2]); }
-  EndReactions Reactions() { return tether.Reactions(x.data(), v.data(), ends, work.data()); }
-};
-
-TetherParams CatenaryParams(int segments) {
-  TetherParams p;
-  p.length = 100;
-  p.segments = segments;
-  p.diameter = 0.02;
-  p.mass_per_length = 1.0;
-  p.EA = 1e5;
-  p.damping = 2e3;
-  p.integrator = Integrator::kImplicit;
-  return p;
-}
 
 // The end tensions of a run started static may change over its first second by at most this
 // fraction (EndTensionsHoldOverTheFirstSecond): the relaxation stops when no node moves by more
