@@ -434,14 +434,9 @@ void EvaluateLead(const mjModel* m, mjData* d, const AttachedTether& at, double*
   // held force, by m_B a_B, the scene fuzzer's "coupling" class (docs/coupling.md, "session 11,
   // s11coup"). Not with explicit: there the node keeps its inertia (taken out, the fuzzer's
   // explicit coupling seeds did not change, and seed 313, a runaway thrust, diverged in the
-  // substeps before the end-damping check named the cause). Only where the node is no heavier
-  // than the body's lightest effective mass: seed 2499 (bdf2, a 27 kg end node of 4 segments on
-  // a 6 kg vehicle) read 408 N for 2.4 N without that condition (not diagnosed).
-  body.node_inertia =
-      tether.params().integrator == Integrator::kExplicit ||
-      tether.NodeInertiaMax(N) > Eigen::SelfAdjointEigenSolver<Mat3>(W_inv, Eigen::EigenvaluesOnly)
-                                     .eigenvalues()
-                                     .minCoeff();
+  // substeps before the end-damping check named the cause). ImplicitStep leaves it out only
+  // where the node is no heavier than the body's lightest effective mass (EndInertia).
+  body.node_inertia = tether.params().integrator == Integrator::kExplicit;
   Vec3 a_other = Vec3::Zero();
   if (!restart) {
     for (int i = 0; i < 3; ++i) a_other[i] = mju_dot(jac + i * m->nv, d->qacc, m->nv);

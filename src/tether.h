@@ -44,9 +44,10 @@ struct EndState {
 // dynamic node carrying the body's effective mass W^-1 besides its own, under the force
 // W^-1 a_other that gives the site the acceleration a_other it has without the tether.
 // node_inertia false (EvaluateLead with the implicit schemes): end node B's own inertia (mass,
-// normal added mass) is left out of its step, so that the node and the body move as the body's
-// mass alone, as the held force has them (docs/coupling.md, "session 11, s11coup"); its forces
-// (segment, weight, drag) stay.
+// normal added mass) is left out of its step where it is no heavier than the body's lightest
+// effective mass, so that the node and the body move as the body's mass alone, as the held
+// force has them (docs/coupling.md, "session 11, s11coup"); its forces (segment, weight, drag)
+// stay.
 struct EndInertia {
   Eigen::Matrix3d mass = Eigen::Matrix3d::Zero();  // [kg] W^-1
   Vec3 force = Vec3::Zero();                       // [N] W^-1 a_other
