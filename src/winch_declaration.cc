@@ -54,10 +54,10 @@ std::optional<WinchParams> ParseWinch(const std::string& text, DeclarationError*
   std::optional<KeyValues> pairs = SplitKeyValues(text, error);
   if (!pairs) return std::nullopt;
   WinchParams w;
-  bool has[std::size(kKeys)] = {};
+  std::vector<bool> has(kKeys.size(), false);  // which keys were given
   for (const auto& [key, value] : *pairs) {
     bool ok = true;
-    for (size_t k = 0; k < kKeys.size(); ++k) has[k] |= key == kKeys[k];
+    for (size_t k = 0; k < kKeys.size(); ++k) has[k] = has[k] || key == kKeys[k];
     if (key == "end") {
       if (value == "A" || value == "B") {
         w.end = value == "A" ? 0 : 1;
