@@ -1201,6 +1201,36 @@ double ThrustOn(const mjModel* m, const mjData* d, int body) {
   return Vec3(d->qfrc_actuator + dof).norm();
 }
 
+// The thrust on a free body at one of the tether's ends against what the tether holds,
+// holds = EA x max_strain [N], from d->qfrc_actuator; empty if below half of it (Diagnose's
+// first cause).
+std::string ThrustCause(const mjModel* m, const mjData* d, const AttachedTether& at,
+                        double holds) {
+  std::ostringstream s;
+  for (int end = 0; end < 2; ++end) {
+    if (at.site[end] < 0 || at.mocap[end] || at.body[end] <= 0) continue;
+    const double thrust = ThrustOn(m, d, at.body[end]);
+    const char* name = mj_id2name(m, mjOBJ_BODY, at.body[end]);
+    if (thrust >= holds) {
+      s << "thrust beyond what the tether holds: the actuators push body '"
+        << (name ? name : "world") << "' with " << thrust << " N, more than EA x max_strain = "
+        << holds << " N; reduce the thrust (or its schedule) below that, or raise EA";
+      return s.str();
+    }
+    // A load taken up suddenly (slack pulled taut, a thrust stepped on) overshoots its static
+    // strain up to twice (undamped spring under a step load).
+    if (thrust >= 0.5 * holds) {
+      s << "a snap load: the actuators push body '" << (name ? name : "world") << "' with "
+        << thrust << " N, more than half of EA x max_strain = " << holds
+        << " N, and a load taken up suddenly overshoots its static strain up to twice; reduce "
+           "the thrust below "
+        << 0.5 * holds << " N, ramp it in slowly, or raise EA";
+      return s.str();
+    }
+  }
+  return "";
+}
+
 // The most likely cause of a divergence, from the state of the scene when it was reported,
 // with what to change; empty if none of the checkable causes applies (the step is then the
 // likely one). In order: thrust beyond what the tether holds, ends pulled apart to a mean
@@ -1219,26 +1249,7 @@ std::string Diagnose(const mjModel* m, const mjData* d, const Environment& env,
     const char* n = mj_id2name(m, mjOBJ_BODY, at.body[end]);
     return std::string(n ? n : "world");
   };
-  for (int end = 0; end < 2; ++end) {
-    if (at.site[end] < 0 || at.mocap[end] || at.body[end] <= 0) continue;
-    const double thrust = ThrustOn(m, d, at.body[end]);
-    if (thrust >= holds) {
-      s << "thrust beyond what the tether holds: the actuators push body '" << body_name(end)
-        << "' with " << thrust << " N, more than EA x max_strain = " << holds
-        << " N; reduce the thrust (or its schedule) below that, or raise EA";
-      return s.str();
-    }
-    // A load taken up suddenly (slack pulled taut, a thrust stepped on) overshoots its static
-    // strain up to twice (undamped spring under a step load).
-    if (thrust >= 0.5 * holds) {
-      s << "a snap load: the actuators push body '" << body_name(end) << "' with " << thrust
-        << " N, more than half of EA x max_strain = " << holds
-        << " N, and a load taken up suddenly overshoots its static strain up to twice; reduce "
-           "the thrust below "
-        << 0.5 * holds << " N, ramp it in slowly, or raise EA";
-      return s.str();
-    }
-  }
+  if (std::string thrust = ThrustCause(m, d, at, holds); !thrust.empty()) return thrust;
   const bool both = at.site[1] >= 0;
   // Positions now; velocities as the tether last saw them (a motion's exact velocity).
   Vec3 pos[2], vel[2];
@@ -1953,7 +1964,7 @@ std::vector<std::string> StallWarnings(const mjModel* m, const mjData* d) {
 
 std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d) {
   const ModelTethers* set = Lookup(m);
-  if (!set) return std::nullopt;
+  if (!set) return VehicleStopped(m, d);  // vehicles without a tether
   for (const AttachedTether& at : set->tethers) {
     const double* u = d->userdata + at.offset;
     if (u[kStatus] == 0) continue;
@@ -2045,6 +2056,28 @@ std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d) {
       s << "Reduce <option timestep> (now " << m->opt.timestep
         << " s) or set max_step for tether substeps, or use fewer segments (now "
         << t.segments() << ").";
+    }
+    return s.str();
+  }
+  int body = -1;
+  if (std::optional<std::string> stopped = VehicleStopped(m, d, &body)) {
+    // What else drives it: the tethers' ends on that body, their last reactions.
+    std::ostringstream s;
+    s << (set->source.empty() ? "" : set->source + ": ") << *stopped;
+    for (const AttachedTether& at : set->tethers) {
+      const double* u = d->userdata + at.offset;
+      for (int end = 0; end < 2; ++end) {
+        if (at.body[end] != body) continue;
+        const TetherParams& p = at.tether.params();
+        s << " Tether '" << at.name << "' pulled it at end " << (end == 0 ? "A" : "B")
+          << " with " << u[end == 0 ? kTensionA : kTensionB]
+          << " N (EA x max_strain = " << p.EA * p.max_strain << " N)";
+        if (at.limit[end].omega_h >= 1) {
+          s << "; its end segment couples strongly to the body: omega h = "
+            << at.limit[end].omega_h << " (docs/coupling.md)";
+        }
+        s << ".";
+      }
     }
     return s.str();
   }

@@ -5,6 +5,7 @@
 
 #include <mujoco/mujoco.h>
 
+#include <optional>
 #include <string>
 
 #include "params.h"
@@ -25,6 +26,12 @@ void DetachVehicles(const mjModel* m);
 // Adds the vehicles' buoyancy, damping and added-mass remainder to d->qfrc_passive (called from
 // the passive callback). Allocates nothing.
 void ApplyVehicles(const mjModel* m, mjData* d);
+
+// Whether a vehicle stopped because its own damping became too stiff for MuJoCo's explicit
+// step (h lambda beyond 2, RK4 2.785, on its worst dof; it then applies no force until a
+// reset): the message, "vehicle 'NAME' stopped at t = ...", without the file name, and the
+// vehicle's body in *body (if not null).
+std::optional<std::string> VehicleStopped(const mjModel* m, const mjData* d, int* body = nullptr);
 
 // The exact velocity of a body moved by a "motion:" declaration at d->time, if its mocap
 // position is the prescribed one at d->time (Prescribe was called); false otherwise.

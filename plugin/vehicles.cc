@@ -1,6 +1,7 @@
 // MuJoCo 2.2 glue for vehicles (Fossen hydrodynamics on free bodies), prescribed motion of
 // mocap bodies and scripted actuator inputs.
 #include <cmath>
+#include <optional>
 #include <cstring>
 #include <memory>
 #include <mutex>
@@ -31,7 +32,14 @@ enum VehicleSlot : int {
   kTime,            // [s] time of the recorded velocity
   kVel,             // [m/s] world velocity of the body origin at kTime (3)
   kAcc = kVel + 3,  // [m/s^2] its finite difference over the last step (3)
-  kVehicleBlock = kAcc + 3,
+  // Set when the vehicle's own damping became too stiff for MuJoCo's step (VehicleStopped):
+  kStopped = kAcc + 3,  // 1 then; the vehicle applies no force until a reset
+  kStopTime,            // [s] d->time of the call that found it
+  kStopRate,            // [-] h lambda of the worst dof
+  kStopDof,             // [-] that dof, 0-5 (surge, sway, heave, roll, pitch, yaw)
+  kStopSpeed,           // [m/s or rad/s] its speed relative to the water
+  kStopMass,            // [kg or kg m^2] its effective mass (body + added)
+  kVehicleBlock,
 };
 
 struct AttachedMotion {
@@ -171,12 +179,50 @@ void DetachVehicles(const mjModel* m) {
   g_models.erase(m);
 }
 
+namespace {
+
+// MuJoCo integrates the vehicle's damping explicitly, like every force from mjcb_passive. On
+// dof i the damping D_l,i nu_i + D_q,i |nu_i| nu_i (Fossen 2011, eq. 6.66, diagonal) changes by
+// lambda_i M_i = D_l,i + 2 D_q,i |nu_i| per unit of velocity, M_i the dof's effective mass (the
+// body's, plus its added mass in the armature). The explicit step multiplies a velocity
+// perturbation by 1 - h lambda_i (Euler; RK4's real-axis limit is h lambda = 2.785): beyond 2
+// it reverses and grows every step until MuJoCo reports a huge QACC and resets the data. The
+// scene fuzzer found such runs (seeds 1885, 6154, 8370: a thrust of millions of newtons drove
+// light vehicles at hundreds of m/s). True when the worst dof is beyond that limit; its figures
+// go into u for VehicleStopped.
+bool DampingTooStiff(const mjModel* m, const AttachedVehicle& av, const Vec6& nu_r, double* u) {
+  const VehicleParams& p = av.vehicle.params();
+  const double h = m->opt.timestep;
+  const double limit = m->opt.integrator == mjINT_RK4 ? 2.785 : 2.0;
+  double worst = 0;
+  int dof = -1;
+  double mass = 0;
+  for (int i = 0; i < 6; ++i) {
+    const double M = i < 3 ? m->body_subtreemass[av.body] + m->dof_armature[av.dof + i]
+                           : m->body_inertia[3 * av.body + i - 3] + m->dof_armature[av.dof + i];
+    const double rate =
+        h * (p.linear_damping[i] + 2 * p.quadratic_damping[i] * std::abs(nu_r[i])) / M;
+    if (rate > worst) worst = rate, dof = i, mass = M;
+  }
+  if (worst <= limit) return false;
+  u[kStopped] = 1;
+  u[kStopRate] = worst;
+  u[kStopDof] = dof;
+  u[kStopSpeed] = std::abs(nu_r[dof]);
+  u[kStopMass] = mass;
+  return true;
+}
+
+}  // namespace
+
 void ApplyVehicles(const mjModel* m, mjData* d) {
   const ModelVehicles* set = Lookup(m);
   if (!set) return;
   for (const AttachedVehicle& av : set->vehicles) {
     const Vehicle& veh = av.vehicle;
     const int b = av.body;
+    double* u = d->userdata + av.offset;
+    if (u[kStopped] != 0) continue;  // stopped (VehicleStopped): inert until a reset
     const Eigen::Map<const RowMat3> R(d->xmat + 9 * b);  // body to world
     const Vec3 origin(d->xpos + 3 * b);
     // Buoyancy at the centre of buoyancy.
@@ -189,12 +235,15 @@ void ApplyVehicles(const mjModel* m, mjData* d) {
     // Free joint: qvel = world velocity of the body origin, then body-frame angular velocity.
     const Vec3 v(d->qvel + av.dof), w(d->qvel + av.dof + 3);
     const Vec6 nu_r = veh.RelativeVelocity(R, v, w, origin.z());
+    if (veh.has_damping() && DampingTooStiff(m, av, nu_r, u)) {
+      u[kStopTime] = d->time;
+      continue;
+    }
     Wrench tau = veh.Damping(nu_r);
     if (veh.has_added_mass()) {
       // The world acceleration over the last step, from the velocities at the last two
       // callback times (with Euler and implicit: the previous step's qacc). A second call at
       // the same time reuses it, so repeated mj_forward calls change nothing.
-      double* u = d->userdata + av.offset;
       if (u[kSet] == 0 || d->time < u[kTime]) {
         u[kSet] = 1;
         u[kTime] = d->time;
@@ -274,6 +323,42 @@ const Vehicle* GetVehicle(const mjModel* m, int k) {
   const ModelVehicles* set = Lookup(m);
   if (!set || k < 0 || k >= static_cast<int>(set->vehicles.size())) return nullptr;
   return &set->vehicles[k].vehicle;
+}
+
+std::optional<std::string> VehicleStopped(const mjModel* m, const mjData* d, int* body) {
+  const ModelVehicles* set = Lookup(m);
+  if (!set) return std::nullopt;
+  static const char* kDof[6] = {"surge", "sway", "heave", "roll", "pitch", "yaw"};
+  for (const AttachedVehicle& av : set->vehicles) {
+    const double* u = d->userdata + av.offset;
+    if (u[kStopped] == 0) continue;
+    if (body) *body = av.body;
+    const int i = static_cast<int>(u[kStopDof]);
+    const VehicleParams& p = av.vehicle.params();
+    const bool lin = i < 3;
+    const double h = m->opt.timestep;
+    const double limit = m->opt.integrator == mjINT_RK4 ? 2.785 : 2.0;
+    std::ostringstream s;
+    s << "vehicle '" << av.name << "' stopped at t = " << u[kStopTime]
+      << " s: its own damping is too stiff for the step: moving in " << kDof[i] << " at "
+      << u[kStopSpeed] << (lin ? " m/s" : " rad/s")
+      << " through the water, its damping D_l + 2 D_q |v| = " << p.linear_damping[i] << " + 2 x "
+      << p.quadratic_damping[i] << " x " << u[kStopSpeed] << " on an effective mass of "
+      << u[kStopMass] << (lin ? " kg" : " kg m^2")
+      << " (body + added) gives h lambda = " << u[kStopRate] << " > " << limit
+      << " at <option timestep> " << h
+      << " s (MuJoCo steps it explicitly: the velocity would reverse and grow every step until "
+         "MuJoCo reports a huge QACC and resets). ";
+    const int j = m->body_jntadr[av.body];
+    const double thrust = j >= 0 ? Vec3(d->qfrc_actuator + m->jnt_dofadr[j]).norm() : 0;
+    if (lin && thrust > 0) {
+      s << "What drives it that fast: the actuators push it with " << thrust << " N. ";
+    }
+    s << "Reduce what drives it (thrust, motion), or <option timestep> below "
+      << h * limit / u[kStopRate] << " s, or make the body heavier.";
+    return s.str();
+  }
+  return std::nullopt;
 }
 
 }  // namespace mjtether

@@ -106,6 +106,7 @@ struct Scene {
   double motion_amp = 0, motion_period = 1;  // [m], [s]; amp 0: no motion
   int motion_axis = 0;
   double mass = 0, added_min = 0;  // [kg] vehicle mass, smallest translational added mass
+  double lin = 0, quad = 0, inertia = 0;  // [N s/m], [N s^2/m^2], [kg m^2] vehicle damping
   double thrust = 0;               // [N] final thrust
   Vec3 thrust_dir = Vec3::UnitX();
   double omega_h = 0;  // [-] coupling frequency at the vehicle times the step
@@ -266,6 +267,7 @@ Scene Make(unsigned long long seed, int draw = kDraw) {
   for (double& a : added) a = s.mass * Uniform(r, 0.3, 1.0);
   s.added_min = std::min({added[0], added[1], added[2]});
   const double lin = s.mass * Uniform(r, 0.2, 2), quad = 0.5 * kRho * side * side;
+  s.lin = lin, s.quad = quad, s.inertia = I;
   if (Chance(r, 0.6)) {
     s.thrust = Uniform(r, 0, 2) * s.holds();
     Vec3 dir = s.b.normalized() + 0.5 * Vec3(Uniform(r, -1, 1), Uniform(r, -1, 1), 0);
@@ -328,6 +330,7 @@ struct Run {
   std::string error, message;
   Vec3 vehicle = Vec3::Zero(), tms = Vec3::Zero();  // [m] at the end (or at divergence)
   double vehicle_speed = 0;                         // [m/s]
+  double peak_speed = 0;  // [m/s or rad/s] largest |v| or |w| of the vehicle at a step's start
   double tension = 0;                               // [N] mean over the last kAverage
   int warnings = 0;
   bool stretched = false;       // Attach warned "starts stretched" (a strain above 0.1%)
@@ -403,6 +406,7 @@ Run Simulate(const Scene& s, double step, double duration = -1) {
   std::vector<double> interior_v;          // [m/s] node velocities, the end nodes' zeroed
   bool started = false;
   for (int k = 0; k < steps; ++k) {
+    run.peak_speed = std::max({run.peak_speed, Vec3(d->qvel).norm(), Vec3(d->qvel + 3).norm()});
     Step(m, d);
     if (std::optional<std::string> message = CheckDivergence(m, d)) {
       run.diverged = true;
@@ -758,6 +762,18 @@ Outcome JudgeRuns(const Scene& s) {
       if (s.seabed_kind != 0) D += 2 * std::sqrt(1e5 * s.mpl) * s.L0() / 2;
       const double bound = kStep * D / (s.mass + s.added_min);
       return {"diverged: end damping too stiff for the step (h lambda > 2)", bound > 2, msg};
+    }
+    if (Contains(msg, "its own damping is too stiff for the step")) {
+      // VehicleStopped (plugin/vehicles.cc): h lambda > 2 on a dof of the vehicle's own
+      // damping. Recomputed as an upper bound: the speed through the water at most the body's
+      // largest |v| or |w| at the start of a step (the callback sees those states) plus the
+      // current, on the translational effective mass m + a_min (damping lin + 2 quad |v|) or
+      // the rotational one 1.3 I (damping I + 2 I |w|).
+      const double v = coarse.peak_speed + s.current.norm();
+      const double translation = kStep * (s.lin + 2 * s.quad * v) / (s.mass + s.added_min);
+      const double rotation = kStep * (1 + 2 * coarse.peak_speed) / 1.3;
+      return {"diverged: vehicle damping too stiff for the step (h lambda > 2)",
+              std::max(translation, rotation) > 2, msg};
     }
     if (Contains(msg, "thrust beyond what the tether holds")) {
       return {"diverged: thrust beyond EA x max_strain", s.thrust >= s.holds(), msg};
