@@ -171,6 +171,7 @@ int Run(const RunOptions& opt) {
   if (!opt.summary.empty()) run_summary.emplace(mm);
   const auto start = std::chrono::steady_clock::now();
   int status = kExitOk;
+  bool stall_noticed = false;
   for (long long i = 0;; ++i) {
     mjtether::Prescribe(mm, d);  // motion: and thrust: declarations at d->time
     if (i == next_sample) {
@@ -195,6 +196,14 @@ int Run(const RunOptions& opt) {
       break;
     }
     if (run_summary) run_summary->Observe(mm, d);
+    // Stalled implicit steps make a run slow: said once, as soon as seen (the check costs a
+    // look at each tether's counter; the full warning with the count comes at the end).
+    if (!stall_noticed) {
+      for (const std::string& w : mjtether::StallWarnings(mm, d, /*early=*/true)) {
+        std::cerr << "mjtether: note: " << w << "\n";
+        stall_noticed = true;
+      }
+    }
   }
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

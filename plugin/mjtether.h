@@ -155,7 +155,10 @@ std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d);
 // kept), per tether since d was made or reset. For each tether with any, a warning naming the
 // file, the tether, the count, when the first one happened and what to change (the time
 // step, the segments, the integrator); `mjtether run` prints it once at the end of a run.
-std::vector<std::string> StallWarnings(const mjModel* m, const mjData* d);
+// early = true: a short notice instead, "FILE: tether 'NAME': its implicit steps began to
+// stall at t = T s ...", which `mjtether run` prints once as soon as it sees one (a stalled
+// step costs up to 256 times a normal one: a long run should not be silent until its end).
+std::vector<std::string> StallWarnings(const mjModel* m, const mjData* d, bool early = false);
 
 // Replaces MuJoCo's default error handler (which waits on stdin) by one that prints the
 // message and exits with status 3, and routes warnings to stderr. Idempotent.

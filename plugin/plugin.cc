@@ -1939,7 +1939,7 @@ int ContactDropped(const mjModel* m, const mjData* d, int k) {
   return static_cast<int>(u[kContactDropped]);
 }
 
-std::vector<std::string> StallWarnings(const mjModel* m, const mjData* d) {
+std::vector<std::string> StallWarnings(const mjModel* m, const mjData* d, bool early) {
   std::vector<std::string> out;
   const ModelTethers* set = Lookup(m);
   if (!set) return out;
@@ -1948,6 +1948,14 @@ std::vector<std::string> StallWarnings(const mjModel* m, const mjData* d) {
     if (u[kStalled] <= 0) continue;
     const Tether& t = at.tether;
     std::ostringstream s;
+    if (early) {
+      s << set->source << ": tether '" << at.name << "': its " << IntegratorName(t.params().integrator)
+        << " steps began to stall at t = " << u[kStalledTime]
+        << " s (a stalled step is retried down to 1/256 of the step, so the run slows down); it "
+           "goes on, and says at its end how many stalled and what to change";
+      out.push_back(s.str());
+      continue;
+    }
     s << set->source << ": tether '" << at.name << "': " << static_cast<long long>(u[kStalled])
       << " " << IntegratorName(t.params().integrator)
       << " step(s) were accepted with the Newton iteration not converged (it stalled even at "

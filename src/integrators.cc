@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 #include <Eigen/Eigenvalues>
 
@@ -1058,6 +1060,16 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
   return status;
 }
 
+namespace {
+// A figure in a divergence reason with nine significant digits: std::to_string's six decimals
+// printed a strain just beyond max_strain 1 as "1.000000 exceeds 1.000000" (session 11).
+std::string Digits(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.9g", x);
+  return text;
+}
+}  // namespace
+
 // Divergence: a non-finite value, a strain no tether survives, or a kinetic energy no tether
 // holds. Each check is one pass without square roots or divisions (x - x is 0 for every finite
 // x and NaN otherwise; the strain is compared squared); the node and the value reported are
@@ -1086,8 +1098,8 @@ void Tether::Check(ConstNodes x, ConstNodes v, const Ends& from, const Ends& to,
     if (strain > p_.max_strain) {
       status.ok = false;
       status.node = j + 1;
-      status.reason = "strain " + std::to_string(strain) + " of segment " + std::to_string(j) +
-                      " exceeds max_strain " + std::to_string(p_.max_strain);
+      status.reason = "strain " + Digits(strain) + " of segment " + std::to_string(j) +
+                      " exceeds max_strain " + Digits(p_.max_strain);
       return;
     }
   }
@@ -1109,8 +1121,8 @@ void Tether::Check(ConstNodes x, ConstNodes v, const Ends& from, const Ends& to,
     }
     status.ok = false;
     status.node = fastest;
-    status.reason = "kinetic energy " + std::to_string(kinetic) + " J exceeds " +
-                    std::to_string(bound) + " J, " + std::to_string(kEnergyBlowUp) +
+    status.reason = "kinetic energy " + Digits(kinetic) + " J exceeds " + Digits(bound) +
+                    " J, " + Digits(kEnergyBlowUp) +
                     " times the most the tether can physically hold";
   }
 }
