@@ -33,6 +33,11 @@ void ApplyVehicles(const mjModel* m, mjData* d);
 // vehicle's body in *body (if not null).
 std::optional<std::string> VehicleStopped(const mjModel* m, const mjData* d, int* body = nullptr);
 
+// The translational force [N] the "thrust:" schedules put on the free root of `body` at their
+// peaks: each fixed-gain, bias-free actuator's gain x the schedule's value of largest magnitude
+// (clamped to ctrlrange) along its moment at d's pose, summed as vectors; 0 without schedules.
+double ScheduledThrust(const mjModel* m, const mjData* d, int body);
+
 // The exact velocity of a body moved by a "motion:" declaration at d->time, if its mocap
 // position is the prescribed one at d->time (Prescribe was called); false otherwise.
 bool PrescribedVelocity(const mjModel* m, const mjData* d, int body, Vec3* vel);

@@ -1,5 +1,6 @@
 // MuJoCo 2.2 glue for vehicles (Fossen hydrodynamics on free bodies), prescribed motion of
 // mocap bodies and scripted actuator inputs.
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <cstring>
@@ -39,6 +40,9 @@ enum VehicleSlot : int {
   kStopDof,             // [-] that dof, 0-5 (surge, sway, heave, roll, pitch, yaw)
   kStopSpeed,           // [m/s or rad/s] its speed relative to the water
   kStopMass,            // [kg or kg m^2] its effective mass (body + added)
+  kGrowth,      // [-] product of h lambda - 1 over the steps since h lambda last was <= limit
+  kGrowthTime,  // [s] d->time of the step last multiplied into kGrowth
+  kGrowthSteps, // [-] the steps in that product
   kVehicleBlock,
 };
 
@@ -185,12 +189,22 @@ namespace {
 // dof i the damping D_l,i nu_i + D_q,i |nu_i| nu_i (Fossen 2011, eq. 6.66, diagonal) changes by
 // lambda_i M_i = D_l,i + 2 D_q,i |nu_i| per unit of velocity, M_i the dof's effective mass (the
 // body's, plus its added mass in the armature). The explicit step multiplies a velocity
-// perturbation by 1 - h lambda_i (Euler; RK4's real-axis limit is h lambda = 2.785): beyond 2
-// it reverses and grows every step until MuJoCo reports a huge QACC and resets the data. The
-// scene fuzzer found such runs (seeds 1885, 6154, 8370: a thrust of millions of newtons drove
-// light vehicles at hundreds of m/s). True when the worst dof is beyond that limit; its figures
-// go into u for VehicleStopped.
-bool DampingTooStiff(const mjModel* m, const AttachedVehicle& av, const Vec6& nu_r, double* u) {
+// perturbation about the motion by 1 - h lambda_i (Euler; RK4's real-axis limit is
+// h lambda = 2.785): beyond 2 it reverses and grows every step, until MuJoCo reports a huge QACC
+// and resets the data. The scene fuzzer found such runs (seeds 1885, 6154, 8370: thrusts of
+// millions of newtons drove light vehicles at hundreds of m/s).
+//
+// A vehicle flung past the limit for a step or two (a snap) is not unstable: the quadratic law
+// then slows it by more than it overshoots (its secant h D_q |v| / M is half the tangent), and
+// the first fuzzer build that stopped at once stopped 5 runs that agreed with their 0.2 ms
+// selves and 11 warned stretched starts that ran. So the growth is accumulated: the product of
+// h lambda - 1 over the consecutive steps beyond the limit (once per MuJoCo step, the worst
+// dof's) must reach kGrowthStop, a perturbation grown a hundredfold. True then; the figures go
+// into u for VehicleStopped.
+constexpr double kGrowthStop = 100;
+
+bool DampingTooStiff(const mjModel* m, const mjData* d, const AttachedVehicle& av,
+                     const Vec6& nu_r, double* u) {
   const VehicleParams& p = av.vehicle.params();
   const double h = m->opt.timestep;
   const double limit = m->opt.integrator == mjINT_RK4 ? 2.785 : 2.0;
@@ -204,7 +218,19 @@ bool DampingTooStiff(const mjModel* m, const AttachedVehicle& av, const Vec6& nu
         h * (p.linear_damping[i] + 2 * p.quadratic_damping[i] * std::abs(nu_r[i])) / M;
     if (rate > worst) worst = rate, dof = i, mass = M;
   }
-  if (worst <= limit) return false;
+  if (worst <= limit) {
+    u[kGrowth] = 0;
+    u[kGrowthSteps] = 0;
+    return false;
+  }
+  // Once per MuJoCo step: the first call at a time at least a step after the last one counted
+  // (RK4's stages at t + h/2 and repeated mj_forward calls at one time do not count again).
+  if (u[kGrowthSteps] == 0 || d->time >= u[kGrowthTime] + 0.99 * h) {
+    u[kGrowth] = (u[kGrowthSteps] == 0 ? 1 : u[kGrowth]) * (worst - 1);
+    u[kGrowthSteps] += 1;
+    u[kGrowthTime] = d->time;
+  }
+  if (u[kGrowth] < kGrowthStop) return false;
   u[kStopped] = 1;
   u[kStopRate] = worst;
   u[kStopDof] = dof;
@@ -235,7 +261,7 @@ void ApplyVehicles(const mjModel* m, mjData* d) {
     // Free joint: qvel = world velocity of the body origin, then body-frame angular velocity.
     const Vec3 v(d->qvel + av.dof), w(d->qvel + av.dof + 3);
     const Vec6 nu_r = veh.RelativeVelocity(R, v, w, origin.z());
-    if (veh.has_damping() && DampingTooStiff(m, av, nu_r, u)) {
+    if (veh.has_damping() && DampingTooStiff(m, d, av, nu_r, u)) {
       u[kStopTime] = d->time;
       continue;
     }
@@ -346,9 +372,10 @@ std::optional<std::string> VehicleStopped(const mjModel* m, const mjData* d, int
       << p.quadratic_damping[i] << " x " << u[kStopSpeed] << " on an effective mass of "
       << u[kStopMass] << (lin ? " kg" : " kg m^2")
       << " (body + added) gives h lambda = " << u[kStopRate] << " > " << limit
-      << " at <option timestep> " << h
-      << " s (MuJoCo steps it explicitly: the velocity would reverse and grow every step until "
-         "MuJoCo reports a huge QACC and resets). ";
+      << " at <option timestep> " << h << " s, beyond it for " << u[kGrowthSteps]
+      << " step(s) in a row: MuJoCo steps the damping explicitly, so a velocity perturbation "
+         "reversed and grew "
+      << u[kGrowth] << "-fold (it would go on until MuJoCo reports a huge QACC and resets). ";
     const int j = m->body_jntadr[av.body];
     const double thrust = j >= 0 ? Vec3(d->qfrc_actuator + m->jnt_dofadr[j]).norm() : 0;
     if (lin && thrust > 0) {
@@ -359,6 +386,32 @@ std::optional<std::string> VehicleStopped(const mjModel* m, const mjData* d, int
     return s.str();
   }
   return std::nullopt;
+}
+
+double ScheduledThrust(const mjModel* m, const mjData* d, int body) {
+  const ModelVehicles* set = Lookup(m);
+  if (!set || body <= 0) return 0;
+  const int root = m->body_rootid[body];
+  const int j = m->body_jntadr[root];
+  if (j < 0 || m->jnt_type[j] != mjJNT_FREE) return 0;
+  const int dof = m->jnt_dofadr[j];
+  Vec3 force = Vec3::Zero();
+  for (const AttachedSchedule& as : set->schedules) {
+    const int a = as.actuator;
+    // Motors and other fixed-gain, bias-free actuators: force = gain x ctrl along the moment.
+    if (m->actuator_gaintype[a] != mjGAIN_FIXED || m->actuator_biastype[a] != mjBIAS_NONE) {
+      continue;
+    }
+    double peak = 0;  // the schedule's value of largest magnitude (linear between its points)
+    for (double c : as.schedule.value) {
+      if (m->actuator_ctrllimited[a]) {
+        c = std::clamp(c, m->actuator_ctrlrange[2 * a], m->actuator_ctrlrange[2 * a + 1]);
+      }
+      if (std::abs(c) > std::abs(peak)) peak = c;
+    }
+    force += m->actuator_gainprm[a * mjNGAIN] * peak * Vec3(d->actuator_moment + a * m->nv + dof);
+  }
+  return force.norm();
 }
 
 }  // namespace mjtether
