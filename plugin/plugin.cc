@@ -706,9 +706,8 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
 // this check MuJoCo reported "Nan, Inf or huge value in QACC" and reset the data (the scene
 // fuzzer's open-thrust-qacc class: h lambda crossed 2 3-48 steps before MuJoCo's warning on
 // seeds 186, 255, 611, 977, 3806). D by central differences of Reactions in the end's velocity
-// (a 3-node window: the cost of three reactions per moving end and call).
-constexpr double kEndDampingLimitEuler = 2.0;
-constexpr double kEndDampingLimitRk4 = 2.785;
+// (a 3-node window: the cost of three reactions per moving end and call). The limit:
+// ExplicitDampingLimit (vehicle_glue.h).
 
 // h lambda for end `end` of `at` in its state at the tether's time, and D's largest eigenvalue
 // [N s/m] and the speed of the site relative to the water [m/s] (for the message).
@@ -808,8 +807,7 @@ void CheckEndDamping(const mjModel* m, mjData* d, const AttachedTether& at, doub
                      double* jac) {
   double* u = d->userdata + at.offset;
   if (u[kStatus] != 0 || u[kInitialized] == 0 || at.winch) return;
-  const double limit =
-      m->opt.integrator == mjINT_RK4 ? kEndDampingLimitRk4 : kEndDampingLimitEuler;
+  const double limit = ExplicitDampingLimit(m);
   for (int end = 0; end < 2; ++end) {
     if (at.site[end] < 0 || !at.coupled[end]) continue;
     // The bound on the load-time effective mass (1 / the largest eigenvalue of W, the same in
@@ -1194,11 +1192,8 @@ bool CheckVehicles(const mjModel* m, const mjData* d, const Environment& env,
 
 // The translational actuator force on the free-joint root of `body` [N] (0 if none).
 double ThrustOn(const mjModel* m, const mjData* d, int body) {
-  const int root = m->body_rootid[body];
-  const int j = m->body_jntadr[root];
-  if (j < 0 || m->jnt_type[j] != mjJNT_FREE) return 0;
-  const int dof = m->jnt_dofadr[j];
-  return Vec3(d->qfrc_actuator + dof).norm();
+  const int dof = FreeRootDof(m, body);
+  return dof >= 0 ? Vec3(d->qfrc_actuator + dof).norm() : 0;
 }
 
 // The thrust on a free body at one of the tether's ends against what the tether holds,
@@ -2046,8 +2041,7 @@ std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d) {
       EndDampingRate(m, const_cast<mjData*>(d), at, end, work.data(), jac.data(), &lambda_D,
                      &speed);
       const char* body = mj_id2name(m, mjOBJ_BODY, at.body[end]);
-      const double limit =
-          m->opt.integrator == mjINT_RK4 ? kEndDampingLimitRk4 : kEndDampingLimitEuler;
+      const double limit = ExplicitDampingLimit(m);
       s << set->source << ": tether '" << at.name << "' stopped at t = " << u[kBadTime]
         << " s: its end " << (end == 0 ? "A" : "B") << " damping too stiff for the step of body '"
         << (body ? body : "?") << "': moving at " << speed

@@ -27,6 +27,18 @@ void DetachVehicles(const mjModel* m);
 // the passive callback). Allocates nothing.
 void ApplyVehicles(const mjModel* m, mjData* d);
 
+// The h lambda beyond which a velocity-dependent force from mjcb_passive, which MuJoCo
+// integrates explicitly, makes a body's velocity reverse and grow every step: 2 for its Euler
+// (and implicit, which does not see the callback's derivatives), 2.785 for RK4 (the real-axis
+// stability limit of the classical RK4). Used for a tether end's damping (plugin.cc) and a
+// vehicle's own (vehicles.cc).
+inline double ExplicitDampingLimit(const mjModel* m) {
+  return m->opt.integrator == mjINT_RK4 ? 2.785 : 2.0;
+}
+
+// The first dof of the free joint at the root of `body`'s tree, or -1 if it has none.
+int FreeRootDof(const mjModel* m, int body);
+
 // Whether a vehicle stopped because its own damping became too stiff for MuJoCo's explicit
 // step (h lambda beyond 2, RK4 2.785, on its worst dof; it then applies no force until a
 // reset): the message, "vehicle 'NAME' stopped at t = ...", without the file name, and the

@@ -2,10 +2,10 @@
 // mocap bodies and scripted actuator inputs.
 #include <algorithm>
 #include <cmath>
-#include <optional>
 #include <cstring>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <shared_mutex>
 #include <sstream>
 #include <unordered_map>
@@ -207,7 +207,7 @@ bool DampingTooStiff(const mjModel* m, const mjData* d, const AttachedVehicle& a
                      const Vec6& nu_r, double* u) {
   const VehicleParams& p = av.vehicle.params();
   const double h = m->opt.timestep;
-  const double limit = m->opt.integrator == mjINT_RK4 ? 2.785 : 2.0;
+  const double limit = ExplicitDampingLimit(m);
   double worst = 0;
   int dof = -1;
   double mass = 0;
@@ -363,7 +363,7 @@ std::optional<std::string> VehicleStopped(const mjModel* m, const mjData* d, int
     const VehicleParams& p = av.vehicle.params();
     const bool lin = i < 3;
     const double h = m->opt.timestep;
-    const double limit = m->opt.integrator == mjINT_RK4 ? 2.785 : 2.0;
+    const double limit = ExplicitDampingLimit(m);
     std::ostringstream s;
     s << "vehicle '" << av.name << "' stopped at t = " << u[kStopTime]
       << " s: its own damping is too stiff for the step: moving in " << kDof[i] << " at "
@@ -376,8 +376,7 @@ std::optional<std::string> VehicleStopped(const mjModel* m, const mjData* d, int
       << " step(s) in a row: MuJoCo steps the damping explicitly, so a velocity perturbation "
          "reversed and grew "
       << u[kGrowth] << "-fold (it would go on until MuJoCo reports a huge QACC and resets). ";
-    const int j = m->body_jntadr[av.body];
-    const double thrust = j >= 0 ? Vec3(d->qfrc_actuator + m->jnt_dofadr[j]).norm() : 0;
+    const double thrust = Vec3(d->qfrc_actuator + av.dof).norm();
     if (lin && thrust > 0) {
       s << "What drives it that fast: the actuators push it with " << thrust << " N. ";
     }
@@ -388,13 +387,15 @@ std::optional<std::string> VehicleStopped(const mjModel* m, const mjData* d, int
   return std::nullopt;
 }
 
+int FreeRootDof(const mjModel* m, int body) {
+  const int j = m->body_jntadr[m->body_rootid[body]];
+  return j >= 0 && m->jnt_type[j] == mjJNT_FREE ? m->jnt_dofadr[j] : -1;
+}
+
 double ScheduledThrust(const mjModel* m, const mjData* d, int body) {
   const ModelVehicles* set = Lookup(m);
-  if (!set || body <= 0) return 0;
-  const int root = m->body_rootid[body];
-  const int j = m->body_jntadr[root];
-  if (j < 0 || m->jnt_type[j] != mjJNT_FREE) return 0;
-  const int dof = m->jnt_dofadr[j];
+  const int dof = body > 0 ? FreeRootDof(m, body) : -1;
+  if (!set || dof < 0) return 0;
   Vec3 force = Vec3::Zero();
   for (const AttachedSchedule& as : set->schedules) {
     const int a = as.actuator;

@@ -16,6 +16,7 @@
 
 #include "catenary_reference.h"
 #include "declaration.h"
+#include "engine_sim.h"
 #include "make_tether.h"
 #include "tether.h"
 #include "validation_record.h"
@@ -33,16 +34,12 @@ using testing::Row;
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kG = 9.81;
 
-// A tether with its state and workspace.
-struct Sim {
-  Tether tether;
-  std::vector<double> x, v, work;
-  Ends ends;
-  explicit Sim(const Tether& t)
-      : tether(t), x(3 * t.nodes()), v(3 * t.nodes()), work(t.WorkspaceSize()) {}
-  void Init() { tether.InitialShape(ends, x.data(), v.data()); }
+// engine_sim.h's tether with its state and workspace, whose steps must not fail, and what the
+// validation cases need besides.
+struct Sim : mjtether::Sim {
+  using mjtether::Sim::Sim;
   StepStatus Step(double dt) {
-    StepStatus s = tether.Advance(x.data(), v.data(), ends, ends, dt, work.data());
+    StepStatus s = mjtether::Sim::Step(dt);
     if (!s.ok) ADD_FAILURE() << "node " << s.node << ": " << s.reason;
     return s;
   }
@@ -53,7 +50,6 @@ struct Sim {
     ends = to;
     return s;
   }
-  Vec3 node(int i) const { return Vec3(x[3 * i], x[3 * i + 1], x[3 * i + 2]); }
   Vec3 vel(int i) const { return Vec3(v[3 * i], v[3 * i + 1], v[3 * i + 2]); }
   void set(int i, const Vec3& p) {
     for (int c = 0; c < 3; ++c) x[3 * i + c] = p[c];
