@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "declaration.h"
+#include "engine_sim.h"
 #include "make_tether.h"
 #include "mjtether.h"
 #include "mjtether_vehicles.h"
@@ -30,13 +31,9 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kG = 9.81;
 
-// A tether with its state and workspace, its ends moved at a constant velocity.
-struct Tow {
-  Tether tether;
-  std::vector<double> x, v, work;
-  Ends ends;
-  explicit Tow(const Tether& t)
-      : tether(t), x(3 * t.nodes()), v(3 * t.nodes()), work(t.WorkspaceSize()) {}
+// engine_sim.h's tether with its state and workspace, its ends moved at a constant velocity.
+struct Tow : Sim {
+  using Sim::Sim;
   // Every node (and the ends) moving at u.
   void SetVelocity(const Vec3& u) {
     for (int i = 0; i < tether.nodes(); ++i) {
@@ -59,7 +56,6 @@ struct Tow {
     }
     return true;
   }
-  EndReactions Reactions() { return tether.Reactions(x.data(), v.data(), ends, work.data()); }
 };
 
 Environment Water(bool gravity) {
