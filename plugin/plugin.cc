@@ -885,8 +885,14 @@ bool Advise(const Tether& t, double timestep, std::string* warning, std::string*
     if (h <= limit) return true;
     s << "integrator=" << name << ": the tether step " << h << " s ("
       << (p.substeps > 0 ? "substeps=" + std::to_string(p.substeps) : "max_step")
-      << ") exceeds the explicit stability limit " << limit << " s; set substeps >= "
-      << static_cast<long long>(std::ceil(timestep / limit)) << " or max_step <= " << limit
+      << ") exceeds the stable step " << limit << " s ("
+      << limit / t.ExplicitStabilityLimit() << " of the stability limit "
+      << t.ExplicitStabilityLimit() << " s"
+      << (p.integrator == Integrator::kExplicit
+              ? "; beyond it a slack tether gains energy at every slack-taut switch"
+              : "")
+      << "); set substeps >= " << static_cast<long long>(std::ceil(timestep / limit))
+      << " or max_step <= " << limit
       << ", or remove both (automatic substeps), or use integrator=implicit";
     *warning = s.str();
     return true;

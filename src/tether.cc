@@ -218,7 +218,8 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
     }
   }
   c.L0_ = L0_save;
-  c.explicit_dt_ = kExplicitSafety * c.explicit_limit_;
+  c.explicit_dt_ =
+      (params.integrator == Integrator::kRK4 ? kRk4Safety : kExplicitSafety) * c.explicit_limit_;
   // The 3-node window for the end reactions: rest length L0 per segment, so its end nodes
   // carry the same lumped length, mass, weight and curvature weights as the tether's.
   if (c.N_ >= 3) {

@@ -166,9 +166,10 @@ class Tether {
   // stiffness and the node masses, reduced for damping (see tether.cc); with integrator=rk4,
   // the limit of RK4 (about 2.8/w).
   double ExplicitStabilityLimit() const { return explicit_limit_; }
-  // The step the explicit schemes take [s]: the limit times the safety factor 0.8
-  // (kExplicitSafety, src/detail/work.h), which covers the geometric stiffness T/l and drag
-  // that the bound leaves out.
+  // The step the explicit schemes take [s]: the limit times a safety factor (src/detail/
+  // work.h), 0.8 with rk4, which covers the geometric stiffness T/l and drag that the bound
+  // leaves out, and 0.5 with explicit, at which symplectic Euler keeps a slack chain's energy
+  // within the work of its ends (kExplicitSafety).
   double ExplicitStableStep() const { return explicit_dt_; }
   // Number of tether steps to cover dt [s] with the configured integrator.
   int SubstepsFor(double dt) const;

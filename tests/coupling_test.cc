@@ -491,7 +491,8 @@ TEST(CouplingExplicit, FreeBodyOnTautTetherGainsNoEnergy) {
 
 // The seabed's stiffness is in the explicit and rk4 stable steps, and so in their automatic
 // substeps: omega_seabed = sqrt(k L0 / m) on the lightest dynamic node (m = mu L0), and the
-// undamped explicit limit 0.8 * 2 / omega with omega^2 = 4 EA/(L0 m) + k L0/m (tether.cc).
+// undamped explicit stable step 0.5 * 2 / omega (symplectic Euler's safety factor) with
+// omega^2 = 4 EA/(L0 m) + k L0/m (tether.cc).
 TEST(Advisor, SeabedStiffnessIsInTheStableStepAndSubsteps) {
   TetherParams p;
   p.length = 10;
@@ -513,8 +514,9 @@ TEST(Advisor, SeabedStiffnessIsInTheStableStepAndSubsteps) {
   EXPECT_NEAR(t->stability_terms().w_seabed, std::sqrt(1e6 * L0 / m), 1e-9);
   EXPECT_NEAR(t->stability_terms().w_axial, std::sqrt(4 * 1e3 / (L0 * m)), 1e-9);
   const double w = std::sqrt(4 * 1e3 / (L0 * m) + 1e6 * L0 / m);
-  EXPECT_NEAR(t->ExplicitStableStep(), 0.8 * 2 / w, 1e-12);
-  EXPECT_EQ(t->SubstepsFor(0.002), static_cast<int>(std::ceil(0.002 / (0.8 * 2 / w) - 1e-9)));
+  EXPECT_NEAR(t->ExplicitStabilityLimit(), 2 / w, 1e-12);
+  EXPECT_NEAR(t->ExplicitStableStep(), 0.5 * 2 / w, 1e-12);
+  EXPECT_EQ(t->SubstepsFor(0.002), static_cast<int>(std::ceil(0.002 / (0.5 * 2 / w) - 1e-9)));
   p.effects = kAxial;
   std::optional<Tether> dry = Tether::Create(p, env, &error);
   EXPECT_GT(t->SubstepsFor(0.002), dry->SubstepsFor(0.002));
@@ -522,7 +524,7 @@ TEST(Advisor, SeabedStiffnessIsInTheStableStepAndSubsteps) {
   p.integrator = Integrator::kRK4;
   std::optional<Tether> rk4 = Tether::Create(p, env, &error);
   EXPECT_NEAR(rk4->stability_terms().w_seabed, std::sqrt(1e6 * L0 / m), 1e-9);
-  EXPECT_LT(rk4->ExplicitStableStep(), 0.8 * 2.9 / w);  // RK4: about 2.8/omega
+  EXPECT_LT(rk4->ExplicitStableStep(), 0.8 * 2.9 / w);  // RK4: about 2.8/omega, factor 0.8
   EXPECT_GT(rk4->ExplicitStableStep(), 0.8 * 2.7 / w);
 }
 

@@ -52,8 +52,9 @@ std::string LineXml(const std::string& extra, double timestep = 0.002,
 // ---------------------------------------------------------------------------------------------
 // Time-step advisor
 
-// An explicit tether whose fixed `substeps` make its step longer than the stability limit gets
-// one warning naming the file, the tether, the limit and the setting to change; the advice is
+// An explicit tether whose fixed `substeps` make its step longer than its stable step gets
+// one warning naming the file, the tether, the stable step and the stability limit it is taken
+// from, and the setting to change; the advice is
 // right: with the substeps it recommends the run stays finite, with the declared ones it
 // diverges.
 TEST_F(Scene, AdvisorWarnsWhenFixedSubstepsExceedTheLimit) {
@@ -65,7 +66,10 @@ TEST_F(Scene, AdvisorWarnsWhenFixedSubstepsExceedTheLimit) {
   ASSERT_EQ(warnings.size(), 1u);
   const std::string& w = warnings[0];
   EXPECT_TRUE(Contains(w, "coarse.xml: <text name=\"tether:line\">")) << w;
-  EXPECT_TRUE(Contains(w, "stability limit " + Fmt(limit) + " s")) << w;
+  EXPECT_TRUE(Contains(w, "stable step " + Fmt(limit) + " s")) << w;
+  const double bound = GetTether(m, 0)->ExplicitStabilityLimit();
+  EXPECT_TRUE(Contains(w, "of the stability limit " + Fmt(bound) + " s")) << w;
+  EXPECT_TRUE(Contains(w, "slack tether gains energy")) << w;
   const int advised = static_cast<int>(std::ceil(0.002 / limit));
   EXPECT_TRUE(Contains(w, "substeps >= " + std::to_string(advised))) << w;
   EXPECT_TRUE(Contains(w, "integrator=implicit")) << w;
