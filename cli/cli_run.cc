@@ -274,6 +274,7 @@ int Info(const std::string& path) {
                 << BodyName(m, c.body) << "'): k_end = EA/L0 = " << c.k_end
                 << " N/m, m_eff = " << c.m_eff << " kg, omega = " << c.omega
                 << " rad/s, omega h = " << c.omega_h;
+      if (c.damping_h > 0) std::cout << ", h damping/(L0 m_eff) = " << c.damping_h;
       if (c.consistent) {
         std::cout << "; consistent coupling (end node B solved with the body in the tether's "
                      "step)";

@@ -74,6 +74,9 @@ struct CouplingLimit {
   // The consistent coupling is on at this end: end node B solved with the body's effective
   // mass inside the tether's step (docs/coupling.md); otherwise the body gets the held force.
   bool consistent = false;
+  // [-] h damping/(L0 m_eff): the end segment's internal damping on the body over the step
+  // (0 without damping); the consistent coupling is also taken from 0.025 on (docs/coupling.md)
+  double damping_h = 0;
 };
 CouplingLimit GetCouplingLimit(const mjModel* m, int k, int end);
 // How the static start of tether k went at load (start=static; docs/static_start.md): pseudo

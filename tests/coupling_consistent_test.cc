@@ -136,6 +136,67 @@ TEST_F(LightVehicle, CarriedByTheCurrentAgreesWithItsFineStep) {
   }
 }
 
+// A heavily damped tether's end on a vehicle (the scene fuzzer's seed 1065; session 13): 240
+// segments of 4.75 cm, EA 5460 N, damping 618 N s (damping/L0 = 1.3e4 N s/m on the end
+// segment), a 25.7 kg vehicle (m_eff 39.3 kg with its added mass) towed by a 1.7 m/s current.
+// omega h is only 0.11 at 2 ms, but h (damping/L0)/m_eff = 0.66: the held force gives the body
+// the damper's force of the last step, and its velocity lags the end node's by a fraction of
+// their relative velocity that this number sets (1 mm/s of lag is 13 N here). With the held
+// force the vehicle-end tension at 0.8 s read 49 N at 2 ms and 22 N at 0.2 ms, against 5.2 N at
+// 0.02 ms. From h (damping/L0)/m_eff = 0.025 on every integrator with the consistent coupling
+// takes it (kLeadFromDamping, plugin/plugin.cc). Asserted: the coupling is consistent at 2 ms
+// and held at 0.02 ms (0.0066), where the reference is run (implicit2); at 2 ms each of
+// implicit2, bdf2 and implicit within 5 mm of the reference's vehicle (it travels 0.56 m;
+// measured 2.0 mm) and its tension within 4% from 0.3 s on (about 5 N; measured 2.0-2.1%).
+TEST_F(LightVehicle, HeavilyDampedEndTakesTheConsistentCouplingAndAgreesWithItsFineStep) {
+  auto xml = [&](double h, const char* integrator) {
+    return std::string("<mujoco><option timestep=\"") + std::to_string(h) +
+           R"("/><custom>
+<text name="water" data="density=1025 current=1.710982405,0.1366513112,0"/>
+<text name="vehicle:rov" data="volume=0.02467059139 cob=0,0,0.02951672181 added_mass=16.92993673,24.06902209,13.56203507,0.1120238811,0.1120238811,0.1120238811 linear_damping=32.52945196,32.52945196,32.52945196,0.3734129369,0.3734129369,0.3734129369 quadratic_damping=44.65088939,44.65088939,44.65088939,0.3734129369,0.3734129369,0.3734129369 coriolis=0"/>
+<text name="tether:t" data="ends=tms_site,att length=11.39554254 segments=240 diameter=0.0147388481 mass_per_length=0.4630903689 EA=5460.080665 Cdn=1.2 Cdt=0.01 Can=1 EI=0.8270511622 EAc=5460.080665 damping=618.2529584 integrator=)" +
+           integrator + R"("/>
+</custom><worldbody>
+<body name="tms" mocap="true"><site name="tms_site"/></body>
+<body name="rov" pos="-2.488161699 0.1836622656 -8.64929372"><freejoint/><inertial pos="0 0 0" mass="25.7160562" diaginertia="0.3734129369 0.3734129369 0.3734129369"/><site name="att"/></body>
+</worldbody></mujoco>)";
+  };
+  const double L0 = 11.39554254 / 240, damping = 618.2529584;  // [m], [N s]
+  std::string stopped;
+  mjModel* fine = Load(xml(0.00002, "implicit2"), "fine.xml");
+  ASSERT_NE(fine, nullptr);
+  const CouplingLimit held = GetCouplingLimit(fine, 0, 1);
+  EXPECT_NEAR(held.damping_h, 0.00002 * damping / (L0 * held.m_eff), 1e-12);
+  EXPECT_LT(held.damping_h, 0.025);
+  EXPECT_FALSE(held.consistent);
+  const std::vector<Sample> ref = RunScene(fine, 0.7, &stopped);
+  ASSERT_EQ(stopped, "");
+  for (const char* integrator : {"implicit2", "bdf2", "implicit"}) {
+    mjModel* m = Load(xml(0.002, integrator), "damped.xml");
+    ASSERT_NE(m, nullptr);
+    const CouplingLimit c = GetCouplingLimit(m, 0, 1);
+    EXPECT_LT(c.omega_h, 0.5) << integrator;  // not consistent for its stiffness
+    EXPECT_NEAR(c.damping_h, 0.002 * damping / (L0 * c.m_eff), 1e-12) << integrator;
+    EXPECT_TRUE(c.consistent) << integrator << ": h damping/(L0 m_eff) = " << c.damping_h;
+    const std::vector<Sample> got = RunScene(m, 0.7, &stopped);
+    ASSERT_EQ(stopped, "") << integrator;
+    ASSERT_EQ(got.size(), ref.size());
+    double pos_err = 0, tension_err = 0;
+    for (size_t i = 0; i < got.size(); ++i) {
+      pos_err = std::max(pos_err, (got[i].pos - ref[i].pos).norm());
+      if (ref[i].t >= 0.3 - 1e-9) {
+        tension_err =
+            std::max(tension_err, std::abs(got[i].tension - ref[i].tension) / ref[i].tension);
+      }
+    }
+    std::printf("%s: position %.2f mm of %.3f m, tension %.2f%% (0.3-0.7 s, about %.1f N)\n",
+                integrator, pos_err * 1e3, (ref.back().pos - ref.front().pos).norm(),
+                100 * tension_err, ref.back().tension);
+    EXPECT_LT(pos_err, 0.005) << integrator;
+    EXPECT_LT(tension_err, 0.04) << integrator;
+  }
+}
+
 // Momentum: a free 5 kg body (no gravity, no water, no damping) 10.001 m from a fixed anchor on
 // a 10 m tether of ten 1 m segments, EA 1e7 (k_end 1e7 N/m: omega h = 2.8 at 2 ms), given
 // 0.1 m/s away from the anchor, 0.5 s at 2 ms. Nothing but the anchor acts on body + tether,
