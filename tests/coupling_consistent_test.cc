@@ -23,6 +23,22 @@ namespace {
 
 using LightVehicle = testing::MuJoCoFixture;
 
+// The largest distance between the two runs' vehicles [m], and the largest relative difference
+// of their vehicle-end tensions from `from` [s] on, over the common samples.
+struct Agreement {
+  double position = 0, tension = 0;
+};
+Agreement Compare(const std::vector<Sample>& got, const std::vector<Sample>& ref, double from) {
+  Agreement a;
+  for (size_t i = 0; i < got.size() && i < ref.size(); ++i) {
+    a.position = std::max(a.position, (got[i].pos - ref[i].pos).norm());
+    if (ref[i].t >= from - 1e-9) {
+      a.tension = std::max(a.tension, std::abs(got[i].tension - ref[i].tension) / ref[i].tension);
+    }
+  }
+  return a;
+}
+
 // A light vehicle on stiff short segments, the kind the scene fuzzer finds: a 3 kg vehicle
 // (added mass 1.5-2.5 kg, in water with a 0.3 m/s current) 4.98 m from the top end of a 5 m
 // tether of ten 0.5 m segments, EA 2e7 (k_end 4e7 N/m, m_eff 4.5 kg: omega h = 6.0 at 2 ms), the
@@ -121,14 +137,8 @@ TEST_F(LightVehicle, CarriedByTheCurrentAgreesWithItsFineStep) {
     const std::vector<Sample> got = RunScene(m, 0.7, &stopped);
     ASSERT_EQ(stopped, "") << integrator;
     ASSERT_EQ(got.size(), ref.size());
-    double pos_err = 0, tension_err = 0;
-    for (size_t i = 0; i < got.size(); ++i) {
-      pos_err = std::max(pos_err, (got[i].pos - ref[i].pos).norm());
-      if (ref[i].t >= 0.2 - 1e-9) {
-        tension_err =
-            std::max(tension_err, std::abs(got[i].tension - ref[i].tension) / ref[i].tension);
-      }
-    }
+    const Agreement a = Compare(got, ref, 0.2);
+    const double pos_err = a.position, tension_err = a.tension;
     std::printf("%s: position %.2f mm of %.3f m, tension %.2f%% (0.2-0.7 s)\n", integrator,
                 pos_err * 1e3, (ref.back().pos - ref.front().pos).norm(), 100 * tension_err);
     EXPECT_LT(pos_err, 0.005) << integrator;
@@ -181,14 +191,8 @@ TEST_F(LightVehicle, HeavilyDampedEndTakesTheConsistentCouplingAndAgreesWithItsF
     const std::vector<Sample> got = RunScene(m, 0.7, &stopped);
     ASSERT_EQ(stopped, "") << integrator;
     ASSERT_EQ(got.size(), ref.size());
-    double pos_err = 0, tension_err = 0;
-    for (size_t i = 0; i < got.size(); ++i) {
-      pos_err = std::max(pos_err, (got[i].pos - ref[i].pos).norm());
-      if (ref[i].t >= 0.3 - 1e-9) {
-        tension_err =
-            std::max(tension_err, std::abs(got[i].tension - ref[i].tension) / ref[i].tension);
-      }
-    }
+    const Agreement a = Compare(got, ref, 0.3);
+    const double pos_err = a.position, tension_err = a.tension;
     std::printf("%s: position %.2f mm of %.3f m, tension %.2f%% (0.3-0.7 s, about %.1f N)\n",
                 integrator, pos_err * 1e3, (ref.back().pos - ref.front().pos).norm(),
                 100 * tension_err, ref.back().tension);
