@@ -802,7 +802,7 @@ double EndDampingBound(const AttachedTether& at, const double* u, int end) {
     const double k = 0.5 * rho * p.diameter * std::max(p.Cdn, 3.14159265358979323846 * p.Cdt);
     D += 2 * k * l * (es.vel - current).norm();
   }
-  if (p.effects & kDamping) D += p.damping / L0;
+  D += t.EndDamping();
   if ((p.effects & kSeabed) && xe.z() > w.seabed - 1e3 * L0) {
     const double c = w.seabed_damping >= 0 ? w.seabed_damping
                                             : 2 * std::sqrt(w.seabed_stiffness * p.mass_per_length);
@@ -1485,10 +1485,10 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
                                : p.integrator == Integrator::kExplicit  ? kLeadFromExplicit
                                                                          : INFINITY;
       // The end segment's internal damping on the body's effective mass over the step.
-      c.damping_h = (p.effects & kDamping) ? h * p.damping / (t.rest_segment_length() * c.m_eff)
-                                           : 0;
-      const bool stiff = c.omega_h >= lead_from ||
-                         (std::isfinite(lead_from) && c.damping_h >= kLeadFromDamping);
+      c.damping_h = h * t.EndDamping() / c.m_eff;
+      const bool has_lead = std::isfinite(lead_from);  // rk4 has no consistent coupling
+      const bool stiff =
+          c.omega_h >= lead_from || (has_lead && c.damping_h >= kLeadFromDamping);
       if (end == 1 && stiff &&
           !at.coupled[0] && !at.winch && !at.contact && !p.clamp_b &&
           FreeCarrier(m, at.body[1]) > 0 && m->opt.integrator != mjINT_RK4) {

@@ -503,6 +503,8 @@ double Tether::EndStiffness() const {
   return (Has(kCompression) ? std::max(p_.EA, p_.EAc) : p_.EA) / L0_;
 }
 
+double Tether::EndDamping() const { return Has(kDamping) ? p_.damping / L0_ : 0.0; }
+
 // Tension only: a compressed segment (compression effect) reads 0, like a slack one.
 void Tether::Tensions(const double* xp, const double* vp, double* T) const {
   ConstNodes x(xp, 3, N_ + 1), v(vp, 3, N_ + 1);

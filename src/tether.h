@@ -253,6 +253,10 @@ class Tether {
   // EAc when compressed segments push back). The time-step advisor's coupling frequency at an
   // attached body of effective mass m_eff is sqrt(k_end/m_eff) (docs/coupling.md).
   double EndStiffness() const;
+  // Internal damping the end segment presents to a site [N s/m]: damping/L0, 0 without the
+  // damping effect. The coupling advisor's h damping/(L0 m_eff) (docs/coupling.md) and the
+  // end-damping bound read it.
+  double EndDamping() const;
 
   // The terms of the explicit stability limit (see Create), each the largest over the dynamic
   // nodes of its node-by-node bound: natural frequencies of the axial chain, the bending
