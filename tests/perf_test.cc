@@ -51,6 +51,56 @@ TEST(BlockBand, MatchesDenseSolve) {
   }
 }
 
+// The matrix of a chain of light nodes on stiff segments, M + h^2 K (fuzzer seed 654: 3.4 g
+// nodes on 1.7 cm segments at EA 1.7e8 N, h = 2 ms: b = h^2 EA/L0 = 3.9e4 kg against m = 3.4e-3
+// kg). The cofactor inverse of a pivot m I + b t t^T cancels to a relative error eps b/m, which
+// reaches the next pivot, m (2b + m)/(m + b) along t, as eps (b/m)^2 of it: at b/m = 1.2e7 the
+// factorisation reported that pivot non-positive and the step failed at t = 0. Such pivots take
+// the LDL^T path (block_band.h). Asserted: the factorisation succeeds on rows with b/m from 1 to
+// 1e9 along random segment directions, and the solve's backward error ||A x - r|| / (||A|| ||x||)
+// is round-off (1e-13, the dense LLT's is ~1e-16; the bound of a backward-stable block solve is
+// a modest multiple of eps); well-conditioned rows still take the cofactor inverse.
+TEST(BlockBand, ChainOfLightNodesOnStiffSegmentsFactorsAndSolvesToRoundOff) {
+  for (double ratio : {1.0, 1e3, 1e6, 1.15e7, 1e9}) {
+    const int nb = 60, n = 3 * nb;
+    const double m = 3.4e-3, b = ratio * m;  // [kg] node mass, h^2 EA/L0
+    std::mt19937 rng(7);
+    std::normal_distribution<double> G;
+    Eigen::MatrixXd A = m * Eigen::MatrixXd::Identity(n, n);
+    // Segment j joins nodes j and j+1 (node nb is a fixed end: segment nb-1 adds to node nb-1's
+    // diagonal block only), each along its own random direction.
+    for (int j = 0; j < nb; ++j) {
+      Eigen::Vector3d t(G(rng), G(rng), G(rng));
+      t.normalize();
+      const Eigen::Matrix3d B = b * t * t.transpose();
+      A.block<3, 3>(3 * j, 3 * j) += B;
+      if (j + 1 < nb) {
+        A.block<3, 3>(3 * (j + 1), 3 * (j + 1)) += B;
+        A.block<3, 3>(3 * (j + 1), 3 * j) -= B;
+        A.block<3, 3>(3 * j, 3 * (j + 1)) -= B;
+      }
+    }
+    std::vector<double> storage(BlockBand::Size(nb));
+    BlockBand F(storage.data(), nb, 1);
+    F.SetZero();
+    for (int i = 0; i < nb; ++i) {
+      F.D(i) = A.block<3, 3>(3 * i, 3 * i);
+      if (i >= 1) F.L1(i) = A.block<3, 3>(3 * i, 3 * (i - 1));
+    }
+    ASSERT_EQ(F.Factor(), -1) << "b/m = " << ratio;
+    if (ratio == 1.0) {
+      EXPECT_EQ(F.StableRows(), 0) << "well conditioned: the cofactor inverse";
+    } else if (ratio >= 1e6) {
+      EXPECT_GT(F.StableRows(), 0);
+    }
+    Eigen::VectorXd r = Eigen::VectorXd::NullaryExpr(n, [&]() { return G(rng); });
+    Eigen::VectorXd x = r;
+    F.Solve(x.data());
+    const double backward = (A * x - r).norm() / (A.norm() * x.norm());
+    EXPECT_LT(backward, 1e-13) << "b/m = " << ratio;
+  }
+}
+
 TEST(BlockBand, ReportsANonPositivePivot) {
   std::vector<double> storage(BlockBand::Size(2));
   BlockBand B(storage.data(), 2, 1);
