@@ -844,6 +844,15 @@ Outcome JudgeRuns(const Scene& s) {
     if (Contains(msg, "start-up strain")) {
       return {"diverged: stretched start", s.b.norm() > s.length, msg};
     }
+    if (Contains(msg, "steps did not converge in")) {
+      // A run of stalled implicit steps (plugin.cc, kStallSteps): the step is the cause where
+      // the same scene at a 10x smaller step runs to the end, as for a step blamed below.
+      const Run fine = Simulate(s, kStep / 10, coarse.duration);
+      const bool ok = fine.loaded && !fine.diverged && fine.finite && fine.warnings == 0;
+      return {
+          "diverged: Newton stalled (10x smaller step runs)", ok,
+          msg + (ok ? "" : " | fine step: " + (fine.message.empty() ? fine.error : fine.message))};
+    }
     if (Contains(msg, "Reduce <option timestep>") || Contains(msg, "stable step")) {
       const Run fine = Simulate(s, kStep / 10, coarse.duration);
       const bool ok = fine.loaded && !fine.diverged && fine.finite && fine.warnings == 0;

@@ -93,4 +93,54 @@ TEST(StallWarning, AbsentWhenNoStepStalled) {
   EXPECT_EQ(output.find("began to stall"), std::string::npos) << output;
 }
 
+// Fuzzer seed 346: a 370 kg vehicle 7.4 m from its TMS on 9.8 m of a stiff line (111 segments,
+// EA 2.5e8 N) that lies partly on a seabed 3.2 m down, implicit, at 2 ms. From t = 0.022 s every
+// step stalls, even at 1/256 of it; before session 14 the run went on for its whole duration
+// (130 s of CPU per simulated second) and ended with the vehicle-end tension frozen at 76 N
+// against 0.195 N at 0.2 ms. Now 50 stalled MuJoCo steps in a row stop it (exit 1), with the
+// time, the cause and what to change; at 0.2 ms no step stalls and the run goes to its end,
+// so the step is the cause, as the message says.
+std::string Seed346(const std::string& step) {
+  return R"(<mujoco><option timestep=")" + step + R"("/><custom>
+<text name="water" data="density=1025 seabed=-3.155209832"/>
+<text name="vehicle:rov" data="volume=0.3681942212 cob=0,0,0.07175483495
+  added_mass=165.60486,207.6434356,287.6279662,9.510992812,9.510992812,9.510992812
+  linear_damping=651.3491577,651.3491577,651.3491577,31.70330937,31.70330937,31.70330937
+  quadratic_damping=263.8737624,263.8737624,263.8737624,31.70330937,31.70330937,31.70330937
+  coriolis=0"/>
+<text name="tether:t" data="ends=tms_site,att length=9.829472374 segments=111
+  diameter=0.006899390972 mass_per_length=0.07618550731 EA=249787896.3 Cdn=1.2 Cdt=0.01 Can=1
+  integrator=implicit"/>
+</custom><worldbody>
+<body name="tms" mocap="true"><site name="tms_site"/></body>
+<body name="rov" pos="7.224253317 1.522510027 -3.095680786"><freejoint/><inertial pos="0 0 0"
+  mass="369.4481613" diaginertia="31.70330937 31.70330937 31.70330937"/><site name="att"/></body>
+</worldbody></mujoco>)";
+}
+
+TEST(StallStop, FiftyStalledStepsInARowStopTheRunWithTheCauseAndTheFineStepRuns) {
+  const std::string coarse = ::testing::TempDir() + "/stall_346.xml";
+  std::ofstream(coarse) << Seed346("0.002");
+  std::string output;
+  EXPECT_EQ(RunCli("run " + coarse + " --duration 0.3", &output), 1) << output;
+  const std::string stop = "mjtether: " + coarse + ": tether 't' stopped at t = ";
+  const size_t at = output.find(stop);
+  ASSERT_NE(at, std::string::npos) << output;
+  // 50 steps after the first stall (0.022 s): at 0.12 s, not at the end of the run.
+  const double t_stop = std::strtod(output.c_str() + at + stop.size(), nullptr);
+  EXPECT_NEAR(t_stop, 0.022 + 49 * 0.002, 1e-9) << output;
+  EXPECT_NE(output.find("its implicit steps did not converge in 50 MuJoCo steps in a row"),
+            std::string::npos)
+      << output;
+  EXPECT_NE(output.find("Reduce <option timestep> (now 0.002 s) or set max_step"),
+            std::string::npos)
+      << output;
+  EXPECT_NE(output.find("or use integrator=implicit2 or explicit"), std::string::npos) << output;
+  const std::string fine = ::testing::TempDir() + "/stall_346_fine.xml";
+  std::ofstream(fine) << Seed346("0.0002");
+  EXPECT_EQ(RunCli("run " + fine + " --duration 0.3", &output), 0) << output;
+  EXPECT_EQ(output.find("began to stall"), std::string::npos) << output;
+  EXPECT_EQ(output.find("not converged"), std::string::npos) << output;
+}
+
 }  // namespace
