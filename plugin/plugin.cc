@@ -2006,6 +2006,18 @@ int ContactDropped(const mjModel* m, const mjData* d, int k) {
   return static_cast<int>(u[kContactDropped]);
 }
 
+namespace {
+// What to change where implicit steps stall: the end-of-run warning's and the stop's advice.
+std::string StallAdvice(const mjModel* m, const Tether& t) {
+  std::ostringstream s;
+  s << "Reduce <option timestep> (now " << m->opt.timestep
+    << " s) or set max_step, use fewer segments (now " << t.segments() << "), or use integrator="
+    << (t.params().integrator == Integrator::kImplicit2 ? "implicit" : "implicit2")
+    << " or explicit (automatic substeps)";
+  return s.str();
+}
+}  // namespace
+
 std::vector<std::string> StallWarnings(const mjModel* m, const mjData* d, bool early) {
   std::vector<std::string> out;
   const ModelTethers* set = Lookup(m);
@@ -2027,11 +2039,8 @@ std::vector<std::string> StallWarnings(const mjModel* m, const mjData* d, bool e
       << " " << IntegratorName(t.params().integrator)
       << " step(s) were accepted with the Newton iteration not converged (it stalled even at "
          "1/256 of the step), the first in the step to t = "
-      << u[kStalledTime] << " s; the tether's motion near then may be wrong. Reduce <option "
-      << "timestep> (now " << m->opt.timestep << " s) or set max_step, use fewer segments (now "
-      << t.segments() << "), or use integrator="
-      << (t.params().integrator == Integrator::kImplicit2 ? "implicit" : "implicit2")
-      << " or explicit (automatic substeps)";
+      << u[kStalledTime] << " s; the tether's motion near then may be wrong. "
+      << StallAdvice(m, t);
     out.push_back(s.str());
   }
   return out;
@@ -2127,11 +2136,7 @@ std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d) {
       // (No Diagnose: a stall is the Newton iteration's, and a cause it would name, such as a
       // thrust schedule not yet ramping, need not have acted: fuzzer seed 5355 stalled from
       // t = 0.002 s, its thrust starting at 0.1 s.)
-      s << "Reduce <option timestep> (now " << m->opt.timestep
-        << " s) or set max_step, use fewer segments (now " << t.segments()
-        << "), or use integrator="
-        << (t.params().integrator == Integrator::kImplicit2 ? "implicit" : "implicit2")
-        << " or explicit (automatic substeps).";
+      s << StallAdvice(m, t) << ".";
       return s.str();
     }
     s << set->source << ": tether '" << at.name << "' diverged at t = " << u[kBadTime]

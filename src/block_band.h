@@ -17,9 +17,8 @@
 //
 // Except where S(i) is ill-conditioned (session 14): the cofactors of S = m I + b t t^T (a
 // node of mass m on a segment of stiffness b = h^2 EA/L0) cancel to a relative error of
-// eps b/m, and the Schur
-// complement of the next row, m (2b + m)/(m + b) along t, is taken from b^2 t^T S^-1 t: an
-// error of eps (b/m)^2 relative to it. At b/m = 1.2e7 (fuzzer seed 654: 148 segments of 1.7 cm
+// eps b/m, and the Schur complement of the next row, m (2b + m)/(m + b) along t, is taken
+// from b^2 t^T S^-1 t: an error of eps (b/m)^2 relative to it. At b/m = 1.2e7 (fuzzer seed 654: 148 segments of 1.7 cm
 // at EA 1.7e8 N, 3.4 g nodes, h = 2 ms) it came out negative and the step failed at t = 0.
 // Such a row (trace(S) trace(S^-1) above kIllConditioned, or a cofactor test that fails) is
 // factored instead by the 3x3 LDL^T S = P E P^T (unit lower P, diagonal E; backward stable,

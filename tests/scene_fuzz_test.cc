@@ -347,6 +347,12 @@ struct Run {
   std::vector<double> tensions;  // [N] the vehicle-end tension after every step (PhaseRange)
 };
 
+// A run that did not go to its end cleanly: not loaded, diverged, a non-finite value or a
+// MuJoCo warning.
+bool Failed(const Run& r) { return !r.loaded || r.diverged || !r.finite || r.warnings > 0; }
+// What stopped a run: its divergence message, or the load error.
+const std::string& Why(const Run& r) { return r.message.empty() ? r.error : r.message; }
+
 // Energy oracle. The tether's energy E = kinetic (interior nodes, normal added mass) +
 // potential (elastic, bending, net weight of every node; Tether::KineticEnergy,
 // PotentialEnergy) changes by the work its ends do on it, W_ends = integral of
@@ -622,9 +628,7 @@ const char kSnapPhase[] =
 // disagree, at 0.02 ms), then the energy balance.
 Outcome Compare(const Scene& s, const Run& coarse) {
   const Run fine = Simulate(s, kStep / 10, coarse.duration);
-  if (!fine.loaded || fine.diverged || !fine.finite || fine.warnings > 0) {
-    return {"fine step failed", false, fine.message.empty() ? fine.error : fine.message};
-  }
+  if (Failed(fine)) return {"fine step failed", false, Why(fine)};
   const double dx = (coarse.vehicle - fine.vehicle).norm();
   const double dT = std::abs(coarse.tension - fine.tension);
   const double tol_x = std::max(0.05, 0.02 * s.span);
@@ -641,8 +645,8 @@ Outcome Compare(const Scene& s, const Run& coarse) {
     // plus that spread. Where the reference is converged (fine = finer) this is the old
     // criterion against a better reference, so a coarse run that is wrong still fails.
     const Run finer = Simulate(s, kStep / 100, coarse.duration);
-    if (!finer.loaded || finer.diverged || !finer.finite || finer.warnings > 0) {
-      detail << "; 0.02 ms run failed: " << (finer.message.empty() ? finer.error : finer.message);
+    if (Failed(finer)) {
+      detail << "; 0.02 ms run failed: " << Why(finer);
       return {"disagrees with 10x smaller step", false, detail.str()};
     }
     const double spread_x = (fine.vehicle - finer.vehicle).norm();
@@ -718,9 +722,8 @@ std::string AfterTheTransient(const Scene& s, double duration) {
   const Run c = Simulate(s, kStep, T), f = Simulate(s, kStep / 10, T);
   std::ostringstream out;
   out << "; after the transient (" << T << " s): ";
-  auto failed = [](const Run& r) { return !r.loaded || r.diverged || !r.finite || r.warnings > 0; };
-  if (failed(c) || failed(f)) {
-    out << "run failed: " << (failed(c) ? c.message + c.error : f.message + f.error);
+  if (Failed(c) || Failed(f)) {
+    out << "run failed: " << (Failed(c) ? c.message + c.error : f.message + f.error);
     return out.str();
   }
   const double dx = (c.vehicle - f.vehicle).norm(), dT = std::abs(c.tension - f.tension);
@@ -812,12 +815,9 @@ Outcome JudgeRuns(const Scene& s) {
       const double t_stop =
           at_stop == std::string::npos ? 0 : std::strtod(msg.c_str() + at_stop + 15, nullptr);
       const Run fine = Simulate(s, kStep / 10, std::max(t_stop, 10 * kStep));
-      const bool ok = t_stop > 0 && fine.loaded && !fine.diverged && fine.finite &&
-                      fine.warnings == 0 && fine.stalled == 0;
+      const bool ok = t_stop > 0 && !Failed(fine) && fine.stalled == 0;
       return {"diverged: Newton stalled (10x smaller step runs to the stop without a stall)", ok,
-              msg + (ok ? ""
-                        : " | fine step: " + (fine.message.empty() ? fine.error : fine.message) +
-                              (fine.stalled > 0 ? " (stalled)" : ""))};
+              msg + (ok ? "" : " | fine step: " + Why(fine) + (fine.stalled > 0 ? " (stalled)" : ""))};
     }
     // A thrust cause also needs the thrust to act: the divergence after the ramp's start
     // (kThrustStart; Diagnose names the schedules' peak while the thrust is still ramping).
@@ -862,10 +862,9 @@ Outcome JudgeRuns(const Scene& s) {
     }
     if (Contains(msg, "Reduce <option timestep>") || Contains(msg, "stable step")) {
       const Run fine = Simulate(s, kStep / 10, coarse.duration);
-      const bool ok = fine.loaded && !fine.diverged && fine.finite && fine.warnings == 0;
-      return {
-          "diverged: step (10x smaller step runs)", ok,
-          msg + (ok ? "" : " | fine step: " + (fine.message.empty() ? fine.error : fine.message))};
+      const bool ok = !Failed(fine);
+      return {"diverged: step (10x smaller step runs)", ok,
+              msg + (ok ? "" : " | fine step: " + Why(fine))};
     }
     return {"diverged: unrecognised cause", false, msg};
   }
@@ -887,9 +886,7 @@ Outcome JudgeRuns(const Scene& s) {
   Scene u = Unstretched(s);
   if (!ExpectedRefusal(u).empty()) return {o.kind, false, o.detail + after};
   const Run uc = Simulate(u, kStep, coarse.duration);
-  if (!uc.loaded || uc.diverged || !uc.finite || uc.warnings > 0) {
-    return {o.kind, false, o.detail + after};
-  }
+  if (Failed(uc)) return {o.kind, false, o.detail + after};
   const Outcome uo = Compare(u, uc);
   const std::string unstretched =
       "; started unstretched: " + (uo.pass ? "agrees: " : uo.kind + ": ") + uo.detail;
