@@ -157,7 +157,9 @@ std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d);
 // (StepStatus::stalled_steps: it stalled even at 1/256 of the step and the last iterate was
 // kept), per tether since d was made or reset. For each tether with any, a warning naming the
 // file, the tether, the count, when the first one happened and what to change (the time
-// step, the segments, the integrator); `mjtether run` prints it once at the end of a run.
+// step, the segments, the integrator); `mjtether run` prints it once at the end of a run. A
+// tether that its stalls stopped (CheckDivergence's "did not converge in 50 MuJoCo steps in
+// a row") is left out: that message says it.
 // early = true: a short notice instead, "FILE: tether 'NAME': its implicit steps began to
 // stall at t = T s ...", which `mjtether run` prints once as soon as it sees one (a stalled
 // step costs up to 256 times a normal one: a long run should not be silent until its end).

@@ -2024,7 +2024,9 @@ std::vector<std::string> StallWarnings(const mjModel* m, const mjData* d, bool e
   if (!set) return out;
   for (const AttachedTether& at : set->tethers) {
     const double* u = d->userdata + at.offset;
-    if (u[kStalled] <= 0) continue;
+    // A tether stopped by its stalls (kStallStop) is not listed: CheckDivergence's message
+    // says it, with the same count and advice (session 14's note: said twice).
+    if (u[kStalled] <= 0 || u[kStatus] == kStallStop) continue;
     const Tether& t = at.tether;
     std::ostringstream s;
     if (early) {
