@@ -1430,6 +1430,57 @@ double CostPerSecond(const Tether& t, double timestep) {
   return steps / timestep * t.nodes() * kNsPerNodeStep[static_cast<int>(t.params().integrator)];
 }
 
+// Thrust schedules that push an end's body beyond what its tether holds, EA x max_strain [N]
+// (max_strain: where a run is declared diverged), or beyond half of it: warned at load, not
+// refused (the body's drag may take part of the thrust, a schedule may be meant to break the
+// run). At run time such a scene usually stops with "thrust beyond what the tether holds" or
+// "a snap load" (Diagnose); one that goes on runs near max_strain, where the snaps' peaks
+// depend on the step: an implicit scheme at 2 ms damps a peak that the same scene at 0.2 ms
+// resolves and diverges on (the scene fuzzer's seeds 9136 and 9153, thrust 0.82 and 1.88 x
+// EA x max_strain, which ran to their end at 2 ms; session 14's "fine step failed"). The peak
+// is ScheduledThrust's (the schedules' largest |ctrl|, through the actuators' moments at
+// qpos0), as Diagnose reads it.
+void WarnThrustBeyondHolds(const mjModel* m, ModelTethers* set) {
+  mjData* scratch = nullptr;
+  for (const AttachedTether& at : set->tethers) {
+    const TetherParams& p = at.tether.params();
+    const double holds = p.EA * p.max_strain;  // [N]
+    for (int end = 0; end < 2; ++end) {
+      if (at.site[end] < 0 || at.mocap[end] || at.body[end] <= 0) continue;
+      if (!scratch) {
+        scratch = mj_makeData(m);
+        if (!scratch) return;
+        mj_kinematics(m, scratch);
+        mj_comPos(m, scratch);
+        mj_transmission(m, scratch);
+      }
+      const double peak = ScheduledThrust(m, scratch, at.body[end]);  // [N]
+      if (!(peak >= 0.5 * holds)) continue;
+      const char* body = mj_id2name(m, mjOBJ_BODY, at.body[end]);
+      std::ostringstream s;
+      s.precision(6);
+      s << set->source << ": <text name=\"tether:" << at.name << "\">: the thrust: schedules push body '"
+        << (body ? body : "?") << "' (end " << "AB"[end] << ") with up to " << peak << " N, ";
+      if (peak >= holds) {
+        s << "more than EA x max_strain = " << holds
+          << " N, what this tether holds: the run stops when the tether strains past max_strain, "
+             "unless the body's drag takes the rest; a run that goes on is near that strain, and "
+             "its snaps and peak tensions depend on <option timestep>: compare with a smaller "
+             "one (or reduce the schedule below "
+          << holds << " N, or raise EA)";
+      } else {
+        s << "more than half of EA x max_strain = " << holds
+          << " N: a load taken up suddenly (a slack tether pulled taut) overshoots its static "
+             "strain up to twice, so its peak may reach max_strain, and that peak depends on "
+             "<option timestep>: compare with a smaller one (or reduce the schedule below "
+          << 0.5 * holds << " N, ramp it in slowly, or raise EA)";
+      }
+      set->warnings.push_back(s.str());
+    }
+  }
+  if (scratch) mj_deleteData(scratch);
+}
+
 // The coupling part of the time-step advisor (docs/coupling.md): for each end on a free body,
 // the coupling frequency omega = sqrt(k_end / m_eff), k_end = EA/L0, m_eff = 1/lambda_max(W)
 // the smallest effective mass of the body at the site (W = J M^-1 J^T at the model's initial
@@ -1803,6 +1854,8 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
   m->nuserdata = offset;
   m->nstack += set->work_size + 6 * std::max(m->nv, 1) + 64;
   set->nuserdata = m->nuserdata;
+  // After the state's size is final: the vehicles' lookup checks it (ScheduledThrust).
+  WarnThrustBeyondHolds(m, set.get());
   {
     std::unique_lock<std::shared_mutex> lock(g_mutex);
     g_models[m] = std::move(set);
