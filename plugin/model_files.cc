@@ -43,7 +43,7 @@ void Collect(const std::string& file, const std::string& top_dir, std::vector<st
              std::vector<std::string>* files, int depth) {
   std::string text;
   if (depth > 32 || !ReadFile(file, &text)) return;
-  for (const std::string& key : {"meshdir", "texturedir"}) {
+  for (const char* key : {"meshdir", "texturedir"}) {
     for (const std::string& d : Attributes(text, key)) {
       dirs->push_back(!d.empty() && d[0] == '/' ? d : top_dir + d + (d.empty() ? "" : "/"));
     }
