@@ -148,6 +148,14 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
     const History hist{hh, history ? hx + 3 * p->first : nullptr,
                        history ? hv + 3 * p->first : nullptr};
     view.Step(x, v, now, next, h, work, &status, history ? &hist : nullptr);
+    // Work of the end forces over the step, as Advance without a winch counts it (the
+    // integrator's last force evaluation along the end's displacement): the coupling's work
+    // balance reads it. Without it a winch tether's balance saw none of the tether's work and
+    // stopped explicit and rk4 runs with a "coupling chatter" at omega h 0.05-0.8 (the scene
+    // fuzzer's world draw, session 15: seeds 105, 276, 300, 489, 560, 756).
+    const ConstNodes f(Work(work, view.N_).f, 3, na);
+    status.work_a += f.col(0).dot(next.a.pos - now.a.pos);
+    if (!view.DynamicB()) status.work_b += f.col(na - 1).dot(next.b.pos - now.b.pos);
     p->rest = next.rest;
     // At most one node per step: a payout of more than L0/2 per tether step is refused at load.
     // A node inserted or removed restarts bdf2 (its history is not remapped: the new node
