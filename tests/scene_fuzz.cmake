@@ -8,6 +8,7 @@ target_link_libraries(scene_fuzz_test PRIVATE mjtether_plugin GTest::gtest_main 
 target_compile_definitions(scene_fuzz_test PRIVATE
   MJTETHER_SCENE_FUZZ_KNOWN="${CMAKE_CURRENT_SOURCE_DIR}/scene_fuzz_known.txt"
   MJTETHER_SCENE_FUZZ_WORLD_KNOWN="${CMAKE_CURRENT_SOURCE_DIR}/scene_fuzz_world_known.txt"
+  MJTETHER_SCENE_FUZZ_WORLD_REGRESSIONS="${CMAKE_CURRENT_SOURCE_DIR}/scene_fuzz_world_regressions.txt"
   MJTETHER_SCENE_FUZZ_REGRESSIONS="${CMAKE_CURRENT_SOURCE_DIR}/scene_fuzz_regressions.txt")
 gtest_discover_tests(scene_fuzz_test NO_PRETTY_VALUES DISCOVERY_TIMEOUT 60
                      PROPERTIES LABELS scene_fuzz TIMEOUT 1500)

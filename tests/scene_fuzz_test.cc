@@ -61,7 +61,8 @@
 //
 // A second test runs the world draw (MakeWorld: the same scenes with a tether touching a geom
 // or paid out by a winch) through the same oracle: MJTETHER_SCENE_FUZZ_WORLD_COUNT (default
-// 150), known failures in tests/scene_fuzz_world_known.txt, the variables above apply.
+// 150), plus the seeds of tests/scene_fuzz_world_regressions.txt, known failures in
+// tests/scene_fuzz_world_known.txt, the variables above apply.
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
 
@@ -991,8 +992,9 @@ std::string ExpectedRefusal(const Scene& s) {
     return "coupling omega h >= limit";
   }
   double over_euler = 0;
-  // Not with a winch: the plugin does not check a compressed start there (CompressedStart).
-  if (!s.winch && StartCompression(s, &over_euler) > 1.01e-3 && over_euler > 1.01) {
+  // With a winch too since session 15 (CompressedStart checks the deployed part, the declared
+  // length in segments of L0: the scene's own tether).
+  if (StartCompression(s, &over_euler) > 1.01e-3 && over_euler > 1.01) {
     return "starts compressed beyond the Euler load";
   }
   // The world draw's (docs/contact.md, docs/winch.md, docs/static_start.md); the margins of 1%
@@ -1480,7 +1482,8 @@ TEST(SceneFuzz, EveryRandomSceneIsRefusedRunsCorrectlyOrDivergesWithACheckedCaus
 TEST(SceneFuzz, TethersThatTouchGeomsOrWinchAreRefusedRunCorrectlyOrDivergeWithACheckedCause) {
   const long count = EnvLong("MJTETHER_SCENE_FUZZ_WORLD_COUNT", 150);
   const long first = EnvLong("MJTETHER_SCENE_FUZZ_FIRST", 1);
-  const std::vector<SceneId> list = SeedList(count, {});
+  const std::vector<SceneId> list =
+      SeedList(count, ReadSeeds(MJTETHER_SCENE_FUZZ_WORLD_REGRESSIONS));
   std::ostringstream title;
   title << "scene fuzzer, world draw: " << list.size() << " scenes (seeds " << first << ".."
         << first + count - 1 << ", or the list given)\n";
