@@ -936,21 +936,29 @@ Outcome CheckRefusal(const Scene& s, const std::string& error) {
   return {"refused: unrecognised cause", false, error};
 }
 
+// In a scene's MJCF, `before` + the old value + `after` replaced by the same with the new value
+// (10 significant digits, as Make writes them); the MJCF emptied where the text is not found
+// (the caller's run then does not load, and nothing is concluded).
+void ReplaceValue(std::string* xml, const std::string& before, double old_value,
+                  double new_value, const std::string& after) {
+  std::ostringstream from, to;
+  from.precision(10);
+  to.precision(10);
+  from << before << old_value << after;
+  to << before << new_value << after;
+  const size_t at = xml->find(from.str());
+  if (at == std::string::npos) {
+    xml->clear();
+  } else {
+    xml->replace(at, from.str().size(), to.str());
+  }
+}
+
 // The scene with its tether as long as the span (no start-up strain), the rest unchanged.
 Scene Unstretched(const Scene& s) {
   Scene u = s;
   u.length = s.b.norm();
-  std::ostringstream from, to;
-  from.precision(10);
-  to.precision(10);
-  from << " length=" << s.length << " ";
-  to << " length=" << u.length << " ";
-  const size_t at = u.xml.find(from.str());
-  if (at == std::string::npos) {
-    u.xml.clear();  // not found: the caller's run does not load, and nothing is concluded
-  } else {
-    u.xml.replace(at, from.str().size(), to.str());
-  }
+  ReplaceValue(&u.xml, " length=", s.length, u.length, " ");
   u.omega_h = std::sqrt(u.EA / (u.L0() * (u.mass + u.added_min))) * kStep;
   if (s.winch && !u.xml.empty()) {
     // The winch's limits widened to hold the twin's length, and its max_speed cut to the
@@ -969,17 +977,7 @@ constexpr double kThrottle = 0.45;  // [-]
 Scene Throttled(const Scene& s) {
   Scene t = s;
   t.thrust = kThrottle * s.holds();
-  std::ostringstream from, to;
-  from.precision(10);
-  to.precision(10);
-  from << " ctrl=0," << s.thrust << "\"";
-  to << " ctrl=0," << t.thrust << "\"";
-  const size_t at = t.xml.find(from.str());
-  if (at == std::string::npos) {
-    t.xml.clear();  // not found: the caller's run does not load, and nothing is concluded
-  } else {
-    t.xml.replace(at, from.str().size(), to.str());
-  }
+  ReplaceValue(&t.xml, " ctrl=0,", s.thrust, t.thrust, "\"");
   return t;
 }
 
