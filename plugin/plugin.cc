@@ -1609,7 +1609,7 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
                   "omega h 10.6), or <option "
                 : "; use integrator=implicit or bdf2 (stable at any omega h measured) or "
                   "implicit2 (not limited on a free body at end B with end A fixed, up to "
-                  "omega h 4 elsewhere), or <option ")
+                  "omega h 1 elsewhere), or <option ")
         << "timestep> <= " << c.limit / c.omega << " s, or fewer segments or a smaller EA";
       if (c.omega_h >= c.limit) {
         *error = where + s.str();

@@ -53,7 +53,7 @@ TEST_P(CouplingCases, AgreeWithTheFineStepOrAreRefusedAtLoad) {
     EXPECT_TRUE(Contains(error, "omega h = ")) << error;
     const std::string name = integrator;
     EXPECT_TRUE(Contains(error, name == "rk4"         ? "limit 0.8"
-                                : name == "implicit2" ? "limit 4"
+                                : name == "implicit2" ? "limit 1"
                                                       : "limit 2"))
         << error;
     EXPECT_TRUE(Contains(error, "use integrator=implicit")) << error;
@@ -149,7 +149,7 @@ TEST_F(Coupling, ImplicitTethersAreNotLimited) {
 // kCouplingLimitImplicit2 = 4, loads without a limit or a warning (its agreement with the
 // 0.1 ms run is BlueRov2/CouplingCases.../EA1_8_implicit2: 2.2 mm, 0.14%). Where the consistent
 // coupling does not apply (MuJoCo's RK4, which calls the callback at t + h/2) the held force
-// keeps its limit 4 and the refusal names bdf2 first.
+// keeps its limit (1 since session 15, 4 before) and the refusal names bdf2 first.
 TEST_F(Coupling, Implicit2IsLimitedOnlyWithTheHeldForce) {
   mjModel* m = Load(BlueRovXml("1e8", "implicit2", 0.002));
   ASSERT_NE(m, nullptr);
@@ -168,7 +168,7 @@ TEST_F(Coupling, Implicit2IsLimitedOnlyWithTheHeldForce) {
   if (rk) models_.push_back(rk);
   EXPECT_TRUE(Contains(error, "rk4.xml: <text name=\"tether:umbilical\">")) << error;
   EXPECT_TRUE(Contains(error, "integrator=implicit2 with end B on body 'rov'")) << error;
-  EXPECT_TRUE(Contains(error, "limit 4")) << error;
+  EXPECT_TRUE(Contains(error, "limit 1")) << error;
   EXPECT_TRUE(Contains(error, "use integrator=bdf2 (the default) or implicit")) << error;
   EXPECT_TRUE(Contains(error, "<option timestep> <= ")) << error;
 }
