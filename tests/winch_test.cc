@@ -527,5 +527,107 @@ TEST_F(WinchTest, WinchAtEndB) {
   EXPECT_NEAR(GetReactions(m, d, 0).tension_a, kMass * kG, 0.005 * kMass * kG);
 }
 
+// The coupling's work balance with a winch (session 15): the winch's Advance counts the work
+// its tether's end forces do along the ends' paths, as Advance without a winch does. Hauling a
+// 50 kg weight in at 0.5 m/s from rest, the tether does ~275 W of work on it; with that work
+// not counted the balance took all of it as spurious and stopped explicit and rk4 runs with a
+// "coupling chatter" within a fraction of a second (the scene fuzzer's world draw: seeds 105,
+// 276, 300, 489, 560, 756, the same stop at 0.2 ms). Here neither integrator stops in 2 s, and
+// the weight follows the drum: it rises by the hauled length within 1 mm.
+TEST_F(WinchTest, HaulInIsNotACouplingChatter) {
+  for (const char* integrator : {"explicit", "rk4"}) {
+    Hanging s;
+    s.integrator = integrator;
+    s.damping = 2e3;
+    s.max_accel = 0.5;
+    mjModel* m = Load(HangingXml(s));
+    ASSERT_NE(m, nullptr);
+    mjData* d = Make(m);
+    Settle(m, d);
+    const double L0 = GetWinch(m, d, 0).length, z0 = d->xpos[3 * 1 + 2];
+    d->ctrl[0] = -0.5;
+    while (d->time < 5) {
+      mj_step(m, d);
+      const std::optional<std::string> stop = CheckDivergence(m, d);
+      ASSERT_FALSE(stop.has_value()) << integrator << ": " << *stop;
+    }
+    const double hauled = L0 - GetWinch(m, d, 0).length;  // [m]
+    EXPECT_GT(hauled, 0.5) << integrator;
+    EXPECT_NEAR(d->xpos[3 * 1 + 2] - z0, hauled, 1e-3) << integrator;
+  }
+}
+
+// The world draw's seed 294 (bdf2, two 73 m segments on a winch in tension mode, a 10 kg vehicle
+// pushed by 1.25 x what the tether holds): the end node's drag on the vehicle at ~20 m/s is too
+// stiff for MuJoCo's step (h lambda 4.8 > 2). Without the winch the scene stops with that cause
+// at 0.346 s; with it the check was skipped (session 14) and the run went on with the vehicle
+// end's reaction at 1.09e5 N against 1.40e4 N at 0.2 ms. Now it stops at the same time.
+TEST_F(WinchTest, FarEndDampingTooStiffForTheStepStops) {
+  const std::string xml = R"(<mujoco><option timestep="0.002"/><custom>
+    <text name="water" data="density=1025 current=-0.4862601888,0.6752557121,0
+      seabed=-61.41315759"/>
+    <text name="vehicle:rov" data="volume=0.0095522185 cob=0,0,0.02156600665
+      added_mass=6.124973215,3.260510453,7.738463806,0.02332484027,0.02332484027,0.02332484027
+      linear_damping=17.84916335,17.84916335,17.84916335,0.07774946756,0.07774946756,0.07774946756
+      quadratic_damping=23.83599795,23.83599795,23.83599795,0.07774946756,0.07774946756,0.07774946756
+      coriolis=0"/>
+    <text name="tether:t" data="ends=tms_site,att length=145.795404 segments=2
+      diameter=0.02480328425 mass_per_length=1.430332782 EA=17246.43873 Cdn=1.2 Cdt=0.01 Can=1
+      integrator=bdf2"/>
+    <text name="thrust:thr" data="t=0.1,0.4 ctrl=0,21546.02375"/>
+    <text name="winch:t" data="end=A mode=tension actuator=winch min_length=82.42931131
+      max_length=307.2911376 max_speed=3.886089765 max_accel=6.34804693 tau=0.3173952899"/>
+    <text name="thrust:winch" data="t=0,1 ctrl=1111.608783,1111.608783"/>
+    </custom><worldbody><body name="tms" mocap="true"><site name="tms_site"/></body>
+    <body name="rov" pos="73.36765687 40.25600689 -60.79246654"><freejoint/>
+      <inertial pos="0 0 0" mass="10.03019103" diaginertia="0.07774946756 0.07774946756 0.07774946756"/>
+      <site name="att"/><site name="thr"/></body></worldbody>
+    <actuator><motor name="thr" site="thr" gear="0.8893298035 0.01511398941 -0.4570164855 0 0 0"/>
+      <motor name="winch" site="tms_site" gear="0 0 0 0 0 0"/></actuator></mujoco>)";
+  mjModel* m = Load(xml, "world294.xml");
+  ASSERT_NE(m, nullptr);
+  mjData* d = Make(m);
+  std::optional<std::string> stop;
+  while (d->time < 1 && !stop) {
+    Step(m, d);
+    stop = CheckDivergence(m, d);
+  }
+  ASSERT_TRUE(stop.has_value()) << "ran to 1 s";
+  EXPECT_NE(stop->find("its end B damping too stiff for the step of body 'rov'"),
+            std::string::npos)
+      << *stop;
+  EXPECT_NEAR(d->time, 0.346, 0.01) << *stop;
+}
+
+// The world draw's seed 451 (implicit2, one 10.7 m segment with EAc and EI paid out by a winch
+// from a TMS 5.97 m from the vehicle): the deployed strut starts compressed to 0.56 of its
+// length, a force far beyond its Euler load. Refused without the winch (CompressedStart); with
+// it the check was skipped (session 14) and the run launched the vehicle (seed 597, the same
+// with implicit: MuJoCo's bad QACC). Now refused at load, naming the strain and the fix.
+TEST_F(WinchTest, DeployedPartCompressedBeyondItsEulerLoadIsRefused) {
+  const std::string error = LoadError(R"(<mujoco><option timestep="0.002"/><custom>
+    <text name="water" data="density=1025 current=1.471668891,-2.579511307,0
+      seabed=-13.25335143"/>
+    <text name="vehicle:rov" data="volume=0.0297727659 cob=0,0,0.03122286666
+      added_mass=9.139957521,14.52669546,13.19078132,0.1483658252,0.1483658252,0.1483658252
+      linear_damping=19.64402185,19.64402185,19.64402185,0.4945527505,0.4945527505,0.4945527505
+      quadratic_damping=49.96195438,49.96195438,49.96195438,0.4945527505,0.4945527505,0.4945527505
+      coriolis=0"/>
+    <text name="tether:t" data="ends=tms_site,att length=10.7041869 segments=1
+      diameter=0.009230301607 mass_per_length=0.1098516553 EA=15138086.85 Cdn=1.2 Cdt=0.01
+      Can=1 integrator=implicit2 EI=3.184095234 EAc=15138086.85"/>
+    <text name="winch:t" data="end=A mode=speed actuator=winch min_length=10.7041869
+      max_length=27.96338757 max_speed=1.187112817 max_accel=3.989767877 tau=0.07677650575"/>
+    <text name="thrust:winch" data="t=0.1,0.3960621196 ctrl=0,-0.6895682787"/>
+    </custom><worldbody><body name="tms" mocap="true"><site name="tms_site"/></body>
+    <body name="rov" pos="0.2080548681 -2.802375757 -5.267999199"><freejoint/>
+      <inertial pos="0 0 0" mass="30.43815492" diaginertia="0.4945527505 0.4945527505 0.4945527505"/>
+      <site name="att"/><site name="thr"/></body></worldbody>
+    <actuator><motor name="winch" site="tms_site" gear="0 0 0 0 0 0"/></actuator></mujoco>)");
+  EXPECT_NE(error.find("<text name=\"tether:t\">: starts compressed"), std::string::npos) << error;
+  EXPECT_NE(error.find("beyond its Euler buckling load"), std::string::npos) << error;
+  EXPECT_NE(error.find("remove EAc"), std::string::npos) << error;
+}
+
 }  // namespace
 }  // namespace mjtether
