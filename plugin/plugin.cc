@@ -1181,6 +1181,85 @@ bool CheckStart(const mjModel* m, const mjData* d, const Environment& env,
   return true;
 }
 
+// A tether whose initial shape starts with its skin inside a geom it touches (contact=): the
+// penalty (contact_stiffness k per metre of tether per metre of penetration) pushes it out in
+// the first steps, an impulse that the step resolves only roughly, like a stretched start's
+// snap. Found where the contact force sees it: FindContacts' planes at qpos0, the depth of a
+// segment the skin's below its lower end's gap, r - min(n.(x_j - p), n.(x_j+1 - p)). Warned
+// where the deepest is beyond kContactStartDepth d and beyond twice the depth at which the
+// contact carries the tether's own net weight, |w|/k (a line that rests on a rock starts near
+// that). The scene fuzzer's world draw found six such starts, 0.7-18 mm inside, that
+// disagreed with their 0.2 ms selves, with no word at load (docs/scene_fuzzer.md, session 16).
+constexpr double kContactStartDepth = 1e-3;  // [-] of the diameter
+
+std::string ContactStartWarning(const mjModel* m, const mjData* d, const Environment& env,
+                                const AttachedTether& at) {
+  if (!at.contact || at.contacts.geoms.empty()) return "";
+  const Tether& t = at.tether;
+  const TetherParams& p = t.params();
+  Ends ends;
+  for (int end = 0; end < 2; ++end) {
+    if (at.site[end] < 0) continue;
+    EndState& e = end == 0 ? ends.a : ends.b;
+    e.pos = Vec3(d->site_xpos + 3 * at.site[end]);
+    const double* R = d->site_xmat + 9 * at.site[end];
+    e.axis = Vec3(R[0], R[3], R[6]);
+  }
+  const int n = t.nodes();
+  std::vector<double> x(3 * n), v(3 * n, 0.0);
+  if (!at.static_x.empty()) {
+    x = at.static_x;
+  } else {
+    t.InitialShape(ends, x.data(), v.data());
+  }
+  std::fill(v.begin(), v.end(), 0.0);
+  std::vector<double> boxes(ChunkBoxesSize(t.segments()));
+  std::vector<ContactPoint> points(at.contacts.capacity);
+  int dropped = 0;
+  const int count = FindContacts(m, d, at.contacts, t, x.data(), v.data(), 0.0, boxes.data(),
+                                 points.data(), at.contacts.capacity, &dropped);
+  const double r = 0.5 * p.diameter;
+  const ConstNodes xs(x.data(), 3, n);
+  double deepest = 0;
+  const ContactPoint* at_deepest = nullptr;
+  for (int k = 0; k < count; ++k) {
+    const ContactPoint& c = points[k];
+    const double gap = std::min(c.normal.dot(xs.col(c.segment) - c.point),
+                                c.normal.dot(xs.col(c.segment + 1) - c.point));
+    if (r - gap > deepest) {
+      deepest = r - gap;
+      at_deepest = &c;
+    }
+  }
+  const double rho = env.wet ? env.water.density : 0;
+  const double w = std::abs(p.mass_per_length - rho * 0.25 * M_PI * p.diameter * p.diameter) *
+                   env.gravity.norm();  // [N/m] net weight per length
+  const double k = p.contact_stiffness;
+  if (!at_deepest || !(deepest > std::max(kContactStartDepth * p.diameter, 2 * w / k))) {
+    return "";
+  }
+  // The geom: the one whose body the point is tagged with and whose plane it is (the first
+  // geom of that body in the contact list when several are).
+  std::string geom = "?";
+  for (const ContactGeom& cg : at.contacts.geoms) {
+    if (m->geom_bodyid[cg.geom] != at_deepest->tag) continue;
+    const char* name = mj_id2name(m, mjOBJ_GEOM, cg.geom);
+    geom = name ? std::string(name) : "#" + std::to_string(cg.geom);
+    break;
+  }
+  const Vec3& q = at_deepest->point;
+  std::ostringstream s;
+  s << "starts inside a geom it touches, far from equilibrium: its skin is " << deepest
+    << " m inside geom '" << geom << "' (segment " << at_deepest->segment << " of "
+    << t.segments() << ", near (" << q.x() << ", " << q.y() << ", " << q.z()
+    << ")), a contact force contact_stiffness x depth = " << k * deepest
+    << " N per metre of tether at the first step; start it clear (move the geom, or the ends, by "
+    << deepest << " m) unless a pressed start is meant (the line is pushed out within the "
+    << "first steps, an impulse whose outcome depends on <option timestep>: compare with a "
+    << "smaller one)";
+  return s.str();
+}
+
 // The iteration cap of the static start: StaticOptions' unless the test hook
 // MJTETHER_STATIC_MAX_ITERATIONS gives another (tests/static_start_test.cc, non-convergence).
 StaticOptions StaticStartOptions() {
@@ -1862,6 +1941,9 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
       }
       if (!warning.empty() && at.tether.params().start == Start::kStatic) {
         set->warnings.push_back(source + ": <text name=\"tether:" + at.name + "\">: " + warning);
+      }
+      if (std::string inside = ContactStartWarning(m, scratch, env, at); !inside.empty()) {
+        set->warnings.push_back(source + ": <text name=\"tether:" + at.name + "\">: " + inside);
       }
     }
     if (ok) ok = CheckVehicles(m, scratch, env, &element, &message);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <sstream>
 #include <string>
 
 #include "mujoco_fixture.h"
@@ -250,6 +251,57 @@ TEST(Reaction, AtTheContactPointTurnsTheBody) {
   // about 1 cm); the centre-of-mass reaction gives 0 to round-off: 3 mm of arm separates them.
   EXPECT_LT(ratio, -0.003) << "the push on the y > 0 half turned the box about -z";
   EXPECT_GT(ratio, -0.2) << "arm at most the half width";
+}
+
+// ---------------------------------------------------------------------------------------------
+// A start inside a geom (ContactStartWarning, plugin.cc): a straight 2 m tether (length = span,
+// 20 segments, d = 2 cm) across a sphere of radius R = 0.3 m centred D below its middle node.
+// The sphere's plane under that node is horizontal, so the skin's depth is exactly
+// r + R - D; warned with that depth (to 1e-9 m: the closest point is computed in closed form)
+// and the geom's name where it exceeds max(1e-3 d, 2 |w|/k), not warned 1 mm clear. With
+// gravity, w = 1 kg/m x 9.81 over k = 1e6: a depth of 1.5e-5 m (below 2 w/k = 1.96e-5 m, at
+// d = 5 mm above 1e-3 d) is a line resting on the rock, not warned; 2.5e-5 m is.
+std::string StartInsideWarning(double depth, double diameter, double gravity) {
+  const double R = 0.3, r = 0.5 * diameter, D = R + r - depth;
+  std::ostringstream xml;
+  xml.precision(17);
+  xml << "<mujoco><option timestep=\"0.002\" gravity=\"0 0 " << -gravity << "\"/><worldbody>"
+      << "<geom name=\"rock\" type=\"sphere\" size=\"" << R << "\" pos=\"0 0 " << -D << "\"/>"
+      << "<site name=\"a\" pos=\"-1 0 0\"/><site name=\"b\" pos=\"1 0 0\"/></worldbody><custom>"
+      << "<text name=\"tether:t\" data=\"ends=a,b length=2 segments=20 diameter=" << diameter
+      << " mass_per_length=1 EA=1e5 contact=all\"/></custom></mujoco>";
+  std::string error;
+  mjModel* m = LoadModelFromString(xml.str(), "inside.xml", &error);
+  EXPECT_NE(m, nullptr) << error;
+  if (!m) return "";
+  std::string found;
+  for (const std::string& w : Warnings(m)) {
+    if (w.find("starts inside a geom") != std::string::npos) found = w;
+  }
+  Detach(m);
+  mj_deleteModel(m);
+  return found;
+}
+
+double DepthOf(const std::string& warning) {
+  const std::string key = "its skin is ";
+  const size_t at = warning.find(key);
+  return at == std::string::npos ? NAN : std::stod(warning.substr(at + key.size()));
+}
+
+TEST(StartInside, IsWarnedWithTheDepthAndTheGeom) {
+  const std::string w = StartInsideWarning(0.005, 0.02, 0);
+  ASSERT_FALSE(w.empty());
+  EXPECT_NEAR(DepthOf(w), 0.005, 1e-9) << w;
+  EXPECT_NE(w.find("inside.xml: <text name=\"tether:t\">"), std::string::npos) << w;
+  EXPECT_NE(w.find("geom 'rock'"), std::string::npos) << w;
+  EXPECT_NE(w.find("depends on <option timestep>"), std::string::npos) << w;
+  EXPECT_TRUE(StartInsideWarning(-0.001, 0.02, 0).empty());
+}
+
+TEST(StartInside, ALineRestingOnTheRockUnderItsWeightIsNotWarned) {
+  EXPECT_TRUE(StartInsideWarning(1.5e-5, 0.005, 9.81).empty());
+  EXPECT_NEAR(DepthOf(StartInsideWarning(2.5e-5, 0.005, 9.81)), 2.5e-5, 1e-9);
 }
 
 }  // namespace
