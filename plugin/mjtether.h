@@ -97,7 +97,8 @@ constexpr double kCouplingLimitExplicit = 2.0;
 constexpr double kCouplingLimitRk4 = 0.8;
 // implicit2 with the held force (after the semismooth Newton of issue 11 item 4): within 1% at
 // omega h = 3.36, 3.4% off in position at 10.6 on the same case; refused from 1 where the
-// consistent coupling does not apply (end A on a body that moves, a winch, clamp_b, MuJoCo's
+// consistent coupling does not apply (end A on a body that moves, a winch (for implicit2; explicit
+// takes it on a winch since session 16), clamp_b, MuJoCo's
 // RK4, end B not under a free joint). 4 until session 15: the scene fuzzer's world draw put
 // implicit2 tethers on a winch (no consistent coupling) and 5 of its 9 scenes at omega h 1-4
 // disagreed with their 0.2 ms selves (seed 141: 27.3 N against 10.0 N at 0.2 ms and 8.7 N at

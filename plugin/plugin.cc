@@ -395,6 +395,30 @@ constexpr double kLeadFromImplicit2 = 0.5;
 // 0.025 are at 0.033-1.9).
 constexpr double kLeadFromDamping = 0.025;
 
+// A winch tether's start shape (a restart of Evaluate or EvaluateLead): the deployed part from
+// the drum exit, the rest on the drum (at site A). A restart keeps the deployment; a reset
+// (kInitialized = 0) restores the declared one. Sets now->rest to the winch segment's.
+void StartWinchShape(const AttachedTether& at, const Tether& tether, double* u, Ends* now,
+                     double* x, double* v) {
+  double* wu = u + (at.winch_offset - at.offset);
+  const double L0 = tether.rest_segment_length();
+  if (u[kInitialized] == 0) {
+    wu[kWinchLength] = at.initial_length;
+    wu[kWinchSpeed] = 0;
+    wu[kWinchFirst] = tether.segments() - std::lround(at.initial_length / L0);
+  }
+  const Payout p = LoadPayout(at, u);
+  const Tether view = tether.Deployed(p.first, p.rest, 0);
+  now->rest = p.rest;
+  view.InitialShape(*now, x + 3 * p.first, v + 3 * p.first);
+  for (int i = 0; i < p.first; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      x[3 * i + c] = now->a.pos[c];
+      v[3 * i + c] = now->a.vel[c];
+    }
+  }
+}
+
 // A tether with the consistent coupling at end B (AttachedTether::lead; docs/coupling.md).
 // At a callback at a new time t the tether is at t (stepped there at the last callback): end
 // node B is snapped to the site's actual position and velocity, and the tether steps ahead to
@@ -433,11 +457,16 @@ void EvaluateLead(const mjModel* m, mjData* d, const AttachedTether& at, double*
   };
   if (!restart && d->time == u[kTime]) return apply();  // the same step again
   const double h = m->opt.timestep;
+  double* wu = u + (at.winch_offset - at.offset);  // winch slots (unused without a winch)
   if (restart) {
-    StartShape(at, tether, now, x.data(), v.data(), work);
+    if (at.winch) {
+      StartWinchShape(at, tether, u, &now, x.data(), v.data());
+    } else {
+      StartShape(at, tether, now, x.data(), v.data(), work);
+    }
     if (history) history[0] = 0;
     RecordStart(u, now, d->time,
-                std::max(0.0, (now.b.pos - now.a.pos).norm() / tether.params().length - 1));
+                std::max(0.0, (now.b.pos - now.a.pos).norm() / DeployedLength(at, u) - 1));
     std::fill(u + kCoupleA, u + kCoupleA + kCoupleSize, 0.0);
     std::fill(u + kCoupleB, u + kCoupleB + kCoupleSize, 0.0);
     std::fill(cache, cache + 12, 0.0);
@@ -486,7 +515,22 @@ void EvaluateLead(const mjModel* m, mjData* d, const AttachedTether& at, double*
   // its position does (ImplicitStep's mixed step).
   from.time = c[kLeadTime];
   to.time = c[kLeadTime] + dt;
-  const StepStatus status = tether.Advance(x.data(), v.data(), from, to, dt, work, history);
+  StepStatus status;
+  if (at.winch) {
+    // The drum's speed over this step from ctrl, the tension at the drum (end A's last
+    // reaction; the winch is at end A, never swapped here) and the limits, as in Evaluate.
+    DrumState drum{wu[kWinchLength], wu[kWinchSpeed]};
+    const double speed =
+        WinchSpeed(at.winch_params, drum, d->ctrl[at.actuator], u[kTensionA], dt);
+    Payout p = LoadPayout(at, u);
+    p.speed = speed;
+    status = tether.Advance(x.data(), v.data(), from, to, dt, work, &p, history);
+    wu[kWinchLength] = drum.length + speed * dt;
+    wu[kWinchSpeed] = speed;
+    wu[kWinchFirst] = p.first;
+  } else {
+    status = tether.Advance(x.data(), v.data(), from, to, dt, work, history);
+  }
   c[kLeadTime] = d->time + h;
   if (!status.ok) return RecordFailure(u, status, d->time);
   CountStalls(status, d->time, u);
@@ -497,7 +541,15 @@ void EvaluateLead(const mjModel* m, mjData* d, const AttachedTether& at, double*
   after.b.pos = x.col(N);
   after.b.vel = v.col(N);
   after.body_b = nullptr;
-  EndReactions r = tether.Reactions(x.data(), v.data(), after, work);
+  EndReactions r;
+  if (at.winch) {
+    const Payout p = LoadPayout(at, u);
+    const Tether view = tether.Deployed(p.first, p.rest, p.speed);
+    after.rest = p.rest;
+    r = view.Reactions(x.data() + 3 * p.first, v.data() + 3 * p.first, after, work);
+  } else {
+    r = tether.Reactions(x.data(), v.data(), after, work);
+  }
   // Where the scheme integrates end A's force over the step (implicit2's stages, explicit's
   // substeps), its mean: the force at t + h alone is not what its nodes' momentum took
   // (docs/coupling.md, implicit2; StepStatus::impulse_a).
@@ -540,24 +592,7 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
     // First call, reset, time went back, or an end was teleported: start again from the
     // declared initial shape.
     if (at.winch) {
-      // The deployed part from the drum exit, the rest on the drum (at site A). A restart
-      // keeps the deployment; a reset (kInitialized = 0) restores the declared one.
-      const double L0 = tether.rest_segment_length();
-      if (u[kInitialized] == 0) {
-        wu[kWinchLength] = at.initial_length;
-        wu[kWinchSpeed] = 0;
-        wu[kWinchFirst] = tether.segments() - std::lround(at.initial_length / L0);
-      }
-      const Payout p = LoadPayout(at, u);
-      const Tether view = tether.Deployed(p.first, p.rest, 0);
-      now.rest = p.rest;
-      view.InitialShape(now, x + 3 * p.first, v + 3 * p.first);
-      for (int i = 0; i < p.first; ++i) {
-        for (int c = 0; c < 3; ++c) {
-          x[3 * i + c] = now.a.pos[c];
-          v[3 * i + c] = now.a.vel[c];
-        }
-      }
+      StartWinchShape(at, tether, u, &now, x, v);
     } else {
       StartShape(at, tether, now, x, v, work);
     }
@@ -1669,7 +1704,10 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
       const bool stiff =
           c.omega_h >= lead_from || (has_lead && c.damping_h >= kLeadFromDamping);
       if (end == 1 && stiff &&
-          !at.coupled[0] && !at.winch && !at.contact && !p.clamp_b &&
+          !at.coupled[0] && !at.contact && !p.clamp_b &&
+          // On a winch (at end A) explicit only: with implicit and bdf2 the world draw's
+          // winch scenes lost accuracy with it (docs/coupling.md, session 16).
+          (!at.winch || (!at.swapped && p.integrator == Integrator::kExplicit)) &&
           FreeCarrier(m, at.body[1]) > 0 && m->opt.integrator != mjINT_RK4) {
         at.lead = t.WithDynamicEndB();
         c.consistent = true;

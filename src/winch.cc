@@ -155,6 +155,12 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
     // fuzzer's world draw, session 15: seeds 105, 276, 300, 489, 560, 756).
     const ConstNodes f(Work(work, view.N_).f, 3, na);
     status.work_a += f.col(0).dot(next.a.pos - now.a.pos);
+    // explicit with a body at end B (the consistent coupling): end A's impulse over the
+    // substeps, as Advance without a winch sums it (the plugin reports its mean).
+    if (p_.integrator == Integrator::kExplicit && dynamic_b_ && next.body_b) {
+      status.impulse_a += h * Vec3(f.col(0));
+      status.has_impulse_a = true;
+    }
     if (!view.DynamicB()) status.work_b += f.col(na - 1).dot(next.b.pos - now.b.pos);
     p->rest = next.rest;
     // At most one node per step: a payout of more than L0/2 per tether step is refused at load.
