@@ -71,6 +71,9 @@ enum CoupleSlot : int {
   kCoupleSteps = 3,  // [-] steps checked
   kDampingRate = 4,  // [-] h lambda of the end's damping on the body (CheckEndDamping)
   kLeadTime = 5,     // [s] end B of a lead tether: the time its state is at (see EvaluateLead)
+  // A lead tether's end A is not coupled: its block (kCoupleA) keeps, from kKnownAccel, the
+  // site's acceleration [m/s^2] (3) from the passive forces at its last step (EvaluateLead).
+  kKnownAccel = 0,
   kCoupleSize = 6,
 };
 static_assert(kCoupleB - kCoupleA == kCoupleSize && kHeader - kCoupleB == kCoupleSize,
@@ -501,11 +504,27 @@ void EvaluateLead(const mjModel* m, mjData* d, const AttachedTether& at, double*
   // substeps before the end-damping check named the cause). ImplicitStep leaves it out only
   // where the node is no heavier than the body's lightest effective mass (EndInertia).
   body.node_inertia = tether.params().integrator == Integrator::kExplicit;
+  // The site's acceleration from the passive forces already applied at this call (MuJoCo's own,
+  // the vehicles' buoyancy, damping and added-mass remainder, tethers evaluated before this
+  // one): M^-1 J^T is in jac after SiteInverseMass, so each is a dot product with qfrc_passive.
+  // These are known at t, so a_other takes them at t rather than lagged: the last step's
+  // (kKnownAccel, end A's slots, unused by a lead tether, whose end A is not coupled) is taken
+  // out of J qacc and this step's put in. Lagged, the vehicle's added-mass remainder, a force
+  // -dA a on the body's own last acceleration, fed back through the end's stiffness: world
+  // seed 530's draw-2 scene (implicit, an 8 kg vehicle with added masses 7.0, 3.0 and 5.3 kg on
+  // EA 5.1e8 over 0.27 m segments, omega h 26) rang from 50 N to 30 kN in 0.17 s against 60 N
+  // at 0.2 ms (docs/coupling.md, session 16).
+  const double* MiJ = jac + 3 * m->nv;
+  Vec3 a_known;
+  for (int i = 0; i < 3; ++i) a_known[i] = mju_dot(MiJ + i * m->nv, d->qfrc_passive, m->nv);
+  double* known_prev = u + kCoupleA + kKnownAccel;
   Vec3 a_other = Vec3::Zero();
   if (!restart) {
     for (int i = 0; i < 3; ++i) a_other[i] = mju_dot(jac + i * m->nv, d->qacc, m->nv);
     a_other -= W * Vec3(cache + 6);
+    a_other += a_known - Vec3(known_prev);
   }
+  for (int i = 0; i < 3; ++i) known_prev[i] = a_known[i];
   body.force = W_inv * a_other;
   Ends from = now, to = now;
   to.a.pos += dt * now.a.vel;
