@@ -162,6 +162,13 @@ Payout LoadPayout(const AttachedTether& at, const double* u) {
   return p;
 }
 
+// The drum's impedance over the step [N s/m] for a winch in tension mode (its law takes the
+// tension at the step's end, WinchSpeed); 0 in speed mode, where the tension is not read.
+double DrumImpedanceFor(const AttachedTether& at, const Tether& tether, const double* x,
+                        const Payout& p, double dt) {
+  return at.winch_params.mode == WinchMode::kTension ? tether.DrumImpedance(x, p, dt) : 0;
+}
+
 // Doubles of mjData stack for one step's contact candidates.
 int ContactWorkSize(const AttachedTether& at) {
   if (!at.contact) return 0;
@@ -539,9 +546,10 @@ void EvaluateLead(const mjModel* m, mjData* d, const AttachedTether& at, double*
     // The drum's speed over this step from ctrl, the tension at the drum (end A's last
     // reaction; the winch is at end A, never swapped here) and the limits, as in Evaluate.
     DrumState drum{wu[kWinchLength], wu[kWinchSpeed]};
-    const double speed =
-        WinchSpeed(at.winch_params, drum, d->ctrl[at.actuator], u[kTensionA], dt);
     Payout p = LoadPayout(at, u);
+    const double Z = DrumImpedanceFor(at, tether, x.data(), p, dt);
+    const double speed =
+        WinchSpeed(at.winch_params, drum, d->ctrl[at.actuator], u[kTensionA], dt, Z);
     p.speed = speed;
     status = tether.Advance(x.data(), v.data(), from, to, dt, work, &p, history);
     wu[kWinchLength] = drum.length + speed * dt;
@@ -644,8 +652,9 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
       DrumState drum{wu[kWinchLength], wu[kWinchSpeed]};
       const double ctrl = d->ctrl[at.actuator];
       const double drum_tension = at.swapped ? u[kTensionB] : u[kTensionA];
-      const double speed = WinchSpeed(at.winch_params, drum, ctrl, drum_tension, dt);
       Payout p = LoadPayout(at, u);
+      const double Z = DrumImpedanceFor(at, tether, x, p, dt);
+      const double speed = WinchSpeed(at.winch_params, drum, ctrl, drum_tension, dt, Z);
       p.speed = speed;
       status = tether.Advance(x, v, from, now, dt, work, &p, history);
       wu[kWinchLength] = drum.length + speed * dt;

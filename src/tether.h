@@ -222,6 +222,14 @@ class Tether {
   // deployed mass mu L and the momentum (docs/winch.md); ends `e` (the drum at end A).
   // Returns +1 (inserted), -1 (removed) or 0.
   int Regrid(double* x, double* v, const Ends& e, Payout* payout) const;
+  // The drum's impedance over a step of dt [N s/m]: by how much the tension at the drum (end A)
+  // drops at the step's end per m/s of payout speed added over the step, the deployed nodes
+  // (state x, the whole allocation) responding along the line as backward Euler steps them:
+  // each node a spring to its place of stiffness m/dt^2 (its mass; added mass is normal only),
+  // each taut segment EA/L0 + damping/(L0 dt) in series (EAc/L0 if compressed, 0 if slack), end
+  // B held (a body) or free. The winch's tension mode takes it implicitly (WinchSpeed).
+  // On a long taut line it is sqrt(mu EA), the axial wave impedance; docs/winch.md.
+  double DrumImpedance(const double* x, const Payout& payout, double dt) const;
 
   // Forces on every node f (3 x n) [N], and segment tensions T (N) [N], >= 0 (a compression
   // reads 0), when T is not null, from the state as it is (ends as stored in x, v).

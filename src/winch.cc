@@ -120,6 +120,62 @@ int Tether::Regrid(double* xp, double* vp, const Ends& e, Payout* p) const {
   return 0;
 }
 
+// Series springs from end B towards the drum, in 3-D: node i resists a displacement over the
+// step with G_i = (m_i I + ma_i (I - t t^T))/he^2 (the implicit solve's inertia term, he its
+// step; added mass normal to the line), segment j with its tangent stiffness
+// K_j = (EA/L0 + damping/(L0 he)) t t^T + (T/l)(I - t t^T) (axial and geometric; EAc/L0 axially
+// when compressed, 0 when slack). What segment j passes on towards the drum, with S behind it
+// (node j+1's G plus what segment j+1 passes on), is K_j - K_j (K_j + S)^-1 K_j (the two in
+// series); a held end B passes K_j. A payout d at the drum lengthens segment 0's rest length,
+// as a drum moved by d towards node 1, so the drum tension drops by t^T P_0 t d, d = v dt. The
+// geometric term lets a curved line take part of the pull sideways over the step. Left out:
+// drag, bending, contact and the vehicle's mass (a body at end B is held). On world seed 861
+// (bdf2, a hanging 34 m line of EA 1.4e7) the vehicle-end tension then converges at first
+// order as the step halves (9.4, 10.5, 11.6 N at 4, 2, 1 ms against 11.8 at 0.2 ms), where the
+// whole step's inertia (he = dt) rang by 1-3 N per step and the straight 1-D chain lagged.
+double Tether::DrumImpedance(const double* xp, const Payout& p, double dt) const {
+  if (!(dt > 0)) return 0;
+  const Tether view = Deployed(p.first, p.rest, p.speed);
+  const int n = view.N_;
+  const ConstNodes x(xp + 3 * p.first, 3, n + 1);
+  // The step the integrator's implicit solve takes (the inertia and damping it sees): bdf2's
+  // is a backward-Euler step of 2 dt/3, implicit2's stages are of (1 - 1/sqrt 2) dt each.
+  // explicit and rk4 follow the true dynamics over dt, which backward Euler's stands in for.
+  const double he = view.p_.integrator == Integrator::kBdf2        ? dt * 2 / 3
+                    : view.p_.integrator == Integrator::kImplicit2 ? dt * 0.29289321881345248
+                                                                   : dt;
+  const double inv_dt2 = 1 / (he * he);
+  const bool added = view.Has(kAddedMass);
+  const Mat3 I = Mat3::Identity();
+  auto inertia = [&](int i, const Vec3& t) -> Mat3 {
+    const Mat3 normal = I - t * t.transpose();
+    return inv_dt2 * (view.Mass(i) * I + (added ? view.Added(i) : 0.0) * normal);
+  };
+  const bool held = !view.p_.free_end;  // end B: a body or fixed (infinitely stiff over the step)
+  Mat3 S = Mat3::Zero(), P = Mat3::Zero();
+  Vec3 t0 = Vec3::UnitX();
+  for (int j = n - 1; j >= 0; --j) {
+    const Vec3 chord = x.col(j + 1) - x.col(j);
+    const double l = chord.norm(), L0 = view.rest_length(j);
+    if (!(l > kMinLengthRatio * L0_)) return 0;  // coincident nodes: no direction to pay along
+    const Vec3 t = chord / l;
+    double axial = 0, T = 0;
+    if (l > L0) {
+      axial = view.p_.EA / L0 + view.p_.damping / (L0 * he);
+      T = view.p_.EA * (l - L0) / L0;
+    } else if (view.Has(kCompression)) {
+      axial = view.p_.EAc / L0 + view.p_.damping / (L0 * he);
+    }
+    const Mat3 K = axial * t * t.transpose() + (T / l) * (I - t * t.transpose());
+    if (j == n - 1 && !held) S = inertia(n, t);
+    P = held && j == n - 1 ? K : Mat3(K - K * (K + S).ldlt().solve(K));
+    S = inertia(j, t) + P;  // node j, as end B's neighbour sees it (unused for j = 0)
+    t0 = t;
+  }
+  const double Z = dt * t0.dot(P * t0);
+  return std::isfinite(Z) && Z > 0 ? Z : 0;
+}
+
 // Without a caller's `history` a bdf2 tether's steps here are backward Euler.
 StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends& to, double dt,
                            double* work, Payout* p, double* history) const {

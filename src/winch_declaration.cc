@@ -116,15 +116,35 @@ std::optional<WinchParams> ParseWinch(const std::string& text, DeclarationError*
 }
 
 double WinchSpeed(const WinchParams& w, const DrumState& s, double ctrl, double tension,
-                  double dt) {
+                  double dt, double impedance) {
   double target = 0;
   if (w.mode == WinchMode::kSpeed) {
     target = std::isfinite(ctrl) ? ctrl : 0;
   } else {
     const double set = std::isfinite(ctrl) ? std::max(ctrl, 0.0) : 0;
-    const double err = tension - set;  // [N] > 0: pay out
-    const double cmd = set > 0 ? w.max_speed * err / (w.band * set) : w.max_speed;
-    target = s.speed + (std::clamp(cmd, -w.max_speed, w.max_speed) - s.speed) * dt / (w.tau + dt);
+    const double b = dt / (w.tau + dt), M = w.max_speed;
+    if (!(set > 0)) {
+      target = s.speed + (M - s.speed) * b;
+    } else {
+      // Backward Euler of tau s' = clamp(gain (T - set)) - s with T at the step's end,
+      // T(v) = tension - Z (v - s.speed): a speed that pays out lowers the tension it is
+      // judged by within the same step. Taken at the step's start (Z = 0) the loop's pole,
+      // (1 + gain Z)/tau, is stepped explicitly, and at gain Z b > 2 the drum and the tension
+      // ring from step to step (a 14 MN/m end segment at 2 ms: 3 to 37 N about a set 30 N;
+      // docs/winch.md). g(v) = v - s - b (clamp(e(v)) - s) increases with v: a saturated root
+      // first, else the linear one.
+      const double gain = M / (w.band * set);  // [m/s per N]
+      const double Z = std::isfinite(impedance) ? std::max(impedance, 0.0) : 0;
+      auto e = [&](double v) { return gain * (tension - set - Z * (v - s.speed)); };
+      const double up = s.speed + (M - s.speed) * b, down = s.speed + (-M - s.speed) * b;
+      if (e(up) >= M) {
+        target = up;
+      } else if (e(down) <= -M) {
+        target = down;
+      } else {
+        target = s.speed + b * (gain * (tension - set) - s.speed) / (1 + b * gain * Z);
+      }
+    }
   }
   double v = std::clamp(target, -w.max_speed, w.max_speed);
   v = std::clamp(v, s.speed - w.max_accel * dt, s.speed + w.max_accel * dt);

@@ -49,13 +49,15 @@ struct DrumState {
 //   speed mode:   target = ctrl;
 //   tension mode: target = max_speed (T - ctrl)/(band ctrl) (pays out above the set tension),
 //                 followed with the first-order lag tau: s += (target - s) dt/(tau + dt)
-//                 (backward Euler of tau s' = target - s);
+//                 (backward Euler of tau s' = target - s), with the tension taken at the
+//                 step's end, T - Z (s - s_prev), Z the drum's impedance [N s/m]
+//                 (Tether::DrumImpedance; 0: the tension at the step's start);
 // then |s| <= max_speed, |s - s_prev| <= max_accel dt, slowing down ahead of a limit at
 // max_accel so as to stop on it, and the brake: a speed that would still carry the length past
 // min_length or max_length within the step is cut so that it stops there (length exactly at
 // the limit), and stays 0 while the command pushes outward.
 double WinchSpeed(const WinchParams& w, const DrumState& s, double ctrl, double tension,
-                  double dt);
+                  double dt, double impedance = 0);
 
 }  // namespace mjtether
 
