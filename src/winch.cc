@@ -147,9 +147,10 @@ double Tether::DrumImpedance(const double* xp, const Payout& p, double dt) const
   const double inv_dt2 = 1 / (he * he);
   const bool added = view.Has(kAddedMass);
   const Mat3 I = Mat3::Identity();
-  auto inertia = [&](int i, const Vec3& t) -> Mat3 {
-    const Mat3 normal = I - t * t.transpose();
-    return inv_dt2 * (view.Mass(i) * I + (added ? view.Added(i) : 0.0) * normal);
+  // Node i's inertia over the step, with tt = t t^T of a segment beside it.
+  auto inertia = [&](int i, const Mat3& tt) -> Mat3 {
+    const double ma = added ? view.Added(i) : 0.0;
+    return inv_dt2 * ((view.Mass(i) + ma) * I - ma * tt);
   };
   const bool held = !view.p_.free_end;  // end B: a body or fixed (infinitely stiff over the step)
   Mat3 S = Mat3::Zero(), P = Mat3::Zero();
@@ -159,6 +160,7 @@ double Tether::DrumImpedance(const double* xp, const Payout& p, double dt) const
     const double l = chord.norm(), L0 = view.rest_length(j);
     if (!(l > kMinLengthRatio * L0_)) return 0;  // coincident nodes: no direction to pay along
     const Vec3 t = chord / l;
+    const Mat3 tt = t * t.transpose();
     double axial = 0, T = 0;
     if (l > L0) {
       axial = view.p_.EA / L0 + view.p_.damping / (L0 * he);
@@ -166,11 +168,16 @@ double Tether::DrumImpedance(const double* xp, const Payout& p, double dt) const
     } else if (view.Has(kCompression)) {
       axial = view.p_.EAc / L0 + view.p_.damping / (L0 * he);
     }
-    const Mat3 K = axial * t * t.transpose() + (T / l) * (I - t * t.transpose());
-    if (j == n - 1 && !held) S = inertia(n, t);
-    P = held && j == n - 1 ? K : Mat3(K - K * (K + S).ldlt().solve(K));
-    S = inertia(j, t) + P;  // node j, as end B's neighbour sees it (unused for j = 0)
+    const double c = T / l;  // geometric stiffness normal to the segment
+    if (j == n - 1 && !held) S = inertia(n, tt);
+    if (axial == 0 && c == 0) {
+      P.setZero();  // a slack segment passes nothing on
+    } else {
+      const Mat3 K = c * I + (axial - c) * tt;
+      P = held && j == n - 1 ? K : Mat3(K - K * ((K + S).inverse() * K));
+    }
     t0 = t;
+    if (j > 0) S = inertia(j, tt) + P;  // node j, as segment j-1 sees it
   }
   const double Z = dt * t0.dot(P * t0);
   return std::isfinite(Z) && Z > 0 ? Z : 0;

@@ -10,6 +10,7 @@
 //   payout/V      paying out at V mm/s (counter inserted = nodes inserted per step)
 //   regrid        one insertion and one removal at the drum (Tether::Regrid): the cost of
 //                 re-discretisation itself, per pair of nodes
+//   impedance     the drum's impedance of the settled line (tension mode, once per step)
 // Payout cost per inserted node = (payout - still) / inserted, or regrid / 2 for the
 // operation alone.
 #include <benchmark/benchmark.h>
@@ -118,6 +119,17 @@ void Regrid(benchmark::State& state) {
   }
 }
 BENCHMARK(Regrid)->Name("regrid");
+
+// The drum's impedance (Tether::DrumImpedance), which a winch in tension mode computes once per
+// MuJoCo step, on the settled hanging line (100 taut segments): compare with `still`.
+void Impedance(benchmark::State& state) {
+  Hang h(true);
+  for (int k = 0; k < 100; ++k) h.Step(0);  // settled
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(h.t.DrumImpedance(h.x.data(), h.payout, 0.002));
+  }
+}
+BENCHMARK(Impedance)->Name("impedance");
 
 }  // namespace
 }  // namespace mjtether
