@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -88,6 +89,20 @@ class WinchTest : public testing::MuJoCoFixture {
       mj_deleteModel(m);
     }
     return error;
+  }
+  // Steps d to t = 1 s at the model's step; from 0.8 s on, calls sample() after each step.
+  // False (and a test failure naming the stop) if the run diverges.
+  bool RunWorldScene(const mjModel* m, mjData* d, const std::function<void()>& sample) {
+    const double step = m->opt.timestep;
+    while (d->time < 1 - 0.5 * step) {
+      mj_step(m, d);
+      if (const std::optional<std::string> stop = CheckDivergence(m, d)) {
+        ADD_FAILURE() << *stop;
+        return false;
+      }
+      if (d->time > 0.8 + 0.5 * step) sample();
+    }
+    return true;
   }
   // Settles the hanging weight with the slide joint's damping, then removes that damping.
   void Settle(mjModel* m, mjData* d) {
@@ -402,21 +417,14 @@ TEST_F(WinchTest, TensionModeOnAStiffLineDoesNotRingAndConverges) {
     d->ctrl[0] = set;  // the thrust: schedule, which the command line applies
     double change = 0, last = NAN, sum = 0;
     int samples = 0;
-    while (d->time < 1 - 0.5 * step) {
-      mj_step(m, d);
-      const std::optional<std::string> stop = CheckDivergence(m, d);
-      if (stop) {
-        ADD_FAILURE() << *stop;
-        return {};
-      }
-      if (d->time > 0.8 + 0.5 * step) {
-        const EndReactions r = GetReactions(m, d, 0);
-        if (samples > 0) change += std::abs(r.tension_a - last);
-        last = r.tension_a;
-        sum += r.tension_b;
-        ++samples;
-      }
-    }
+    const bool ran = RunWorldScene(m, d, [&] {
+      const EndReactions r = GetReactions(m, d, 0);
+      if (samples > 0) change += std::abs(r.tension_a - last);
+      last = r.tension_a;
+      sum += r.tension_b;
+      ++samples;
+    });
+    if (!ran) return {};
     return {change / (samples - 1), sum / samples};
   };
   for (const std::string integrator : {"bdf2", "implicit"}) {
@@ -808,16 +816,9 @@ TEST_F(WinchTest, ExplicitOnALightVehicleTakesTheConsistentCoupling) {
     mjData* d = Make(m);
     double sum = 0;
     int samples = 0;
-    while (d->time < 1 - 0.5 * step) {
-      mj_step(m, d);
-      const std::optional<std::string> stop = CheckDivergence(m, d);
-      if (stop) {
-        ADD_FAILURE() << *stop;
-        return NAN;
-      }
-      if (d->time > 0.8 + 0.5 * step) sum += GetReactions(m, d, 0).tension_b, ++samples;
-    }
-    return sum / samples;
+    const bool ran =
+        RunWorldScene(m, d, [&] { sum += GetReactions(m, d, 0).tension_b, ++samples; });
+    return ran ? sum / samples : NAN;
   };
   bool coarse_consistent = false, fine_consistent = true;
   const double coarse = mean_tension(0.002, &coarse_consistent);
