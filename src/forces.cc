@@ -79,7 +79,7 @@ void Tether::AddAxial(ConstNodes x, ConstNodes v, ConstNodes t, const double* l,
     Vec3 dv = (L0_ / r) * (Vec3(v.col(1) - v.col(0)) - (lr * speed_) * t.col(0));
     if (engaging) {
       const double rs = std::max(r - speed_ * start->h, 1e-9 * L0_);  // rest at the start
-      const double es = (start->x.col(1) - start->x.col(0)).norm() / rs - 1;
+      const double es = (start->at(1) - start->at(0)).norm() / rs - 1;
       const double e = lr - 1;
       if (e > 0 ? es <= 0 : e < 0 && es >= 0) engage_h = start->h;
       if (start->discrete) {
@@ -98,7 +98,7 @@ void Tether::AddAxial(ConstNodes x, ConstNodes v, ConstNodes t, const double* l,
     Vec3 dv = v.col(j + 1) - v.col(j);
     if (engaging) {
       // On the other side of L0 at the start of the step than now?
-      const double ls2 = (start->x.col(j + 1) - start->x.col(j)).squaredNorm();
+      const double ls2 = (start->at(j + 1) - start->at(j)).squaredNorm();
       if (l[j] > L0_ ? ls2 <= L0sq : l[j] < L0_ && ls2 >= L0sq) engage_h = start->h;
       if (start->discrete) {
         // In the Newton iterations past the first: the backward difference of the engaged

@@ -197,7 +197,7 @@ void Tether::Rk4Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double
 // (3x3 blocks, two off-diagonals with bending, one without): a block Cholesky with fixed-size
 // 3x3 blocks (block_band.h) solves it, assembled directly block by block.
 bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
-                          double* work, StepStatus* stats) const {
+                          double* work, StepStatus* stats, bool scheme_start) const {
   Work w(work, N_);
   const int n = N_ + 1;
   const int nu = N_ - 1 + (DynamicB() ? 1 : 0);  // dynamic nodes 1..nu, unknown u = i - 1
@@ -244,6 +244,21 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
   const double h2 = h * h;
   const bool added = Has(kAddedMass);
   Start start{ConstNodes(x.data(), 3, n), h, false};
+  // scheme_start: the dynamic nodes start from the scheme's own point, not from the state at
+  // now (bdf2's extrapolated x-hat with its step he, implicit2's second stage from x~ with
+  // gamma h). The prescribed ends then start where that step puts them, x(t + h) - he v(t + h),
+  // so that the damping's backward difference of an end segment's length (the Newton
+  // iterations past the first) reads t . (v_end - v_node) at convergence, the rate of the
+  // first iteration and of Reactions, whose force the body receives. From their true position
+  // (bdf2) or their position at t + gamma h (implicit2) they read a rate of v/2 or 1.4 v
+  // along the end segment that neither node has: scene fuzzer seed 658 (bdf2, damping 16.8 N s
+  // on 5.8 cm segments, a vehicle towed at 1.5 m/s) put 50 N for 16 N on its vehicle, growing
+  // (docs/numerics.md, "The ends' start in bdf2 and implicit2"). Backward Euler starts from the
+  // state at now: its ends' true start is its own.
+  if (scheme_start) {
+    start.end_a = next.a.pos - h * next.a.vel;
+    if (!DynamicB()) start.end_b = next.b.pos - h * next.b.vel;
+  }
   const double body_min_mass =
       body ? Eigen::SelfAdjointEigenSolver<Mat3>(body->mass, Eigen::EigenvaluesOnly)
                  .eigenvalues()
@@ -923,7 +938,7 @@ void Tether::Sdirk2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, dou
   }
   Ends from = mid;
   if (mixed) from.time = now.time;
-  if (!ImplicitStep(x, v, from, next, kGamma * h, work, stats)) return fall_back();
+  if (!ImplicitStep(x, v, from, next, kGamma * h, work, stats, true)) return fall_back();
   if (mixed) {
     stats->impulse_a +=
         (1 - kGamma) * h * fa1 + kGamma * h * EndForceA(*this, x.data(), v.data(), next, work);
@@ -989,7 +1004,7 @@ void Tether::Bdf2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, doubl
     x.col(i) += c * dx.col(i);
     v.col(i) += c * dv.col(i);
   }
-  if (!ImplicitStep(x, v, now, next, he, work, stats)) {
+  if (!ImplicitStep(x, v, now, next, he, work, stats, true)) {
     x = xs;
     v = vs;
     return backward_euler();

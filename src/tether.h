@@ -17,6 +17,7 @@
 #ifndef MJTETHER_SRC_TETHER_H_
 #define MJTETHER_SRC_TETHER_H_
 
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <string>
@@ -293,6 +294,14 @@ class Tether {
     double h;      // [s]
     bool discrete;  // damping on the backward difference of the strain over the step
                     // (the Newton iterations past the first, see ImplicitStep)
+    // [m] Where set (not NaN), the prescribed ends' start instead of x.col(0) and x.col(N):
+    // see ImplicitStep's `scheme_start`.
+    Vec3 end_a = Vec3::Constant(NAN), end_b = Vec3::Constant(NAN);
+    Vec3 at(int i) const {
+      if (i == 0 && !std::isnan(end_a.x())) return end_a;
+      if (i == x.cols() - 1 && !std::isnan(end_b.x())) return end_b;
+      return x.col(i);
+    }
   };
   // ComputeForces, with the implicit step's start when `start` is not null.
   void Forces(const double* x, const double* v, const Ends& ends, double* f, double* T,
@@ -339,7 +348,7 @@ class Tether {
   void Rk4Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
                double* work) const;
   bool ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
-                    double* work, StepStatus* stats) const;
+                    double* work, StepStatus* stats, bool scheme_start = false) const;
   void ImplicitStepAdaptive(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
                             int depth, double* work, StepStatus* stats,
                             double impulse_weight = 1) const;
