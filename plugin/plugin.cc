@@ -2346,6 +2346,13 @@ std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d) {
       } else if (const double thrust = ThrustOn(m, d, at.body[end]); thrust > 0) {
         s << "The actuators push body '" << (body ? body : "?") << "' with " << thrust << " N. ";
       }
+      // A thrust schedule beyond what the tether holds drives the body ever faster: a smaller
+      // step only delays the stop (Diagnose says so), so the step is not offered as the cure.
+      if (cause.rfind("thrust beyond what the tether holds", 0) == 0) {
+        s << "Reduce what drives the body that fast (thrust, motion) or make the body heavier; a "
+             "smaller <option timestep> would only delay this.";
+        return s.str();
+      }
       s << "Reduce <option timestep> below " << m->opt.timestep * limit / rate
         << " s, or reduce what drives the body that fast (thrust, motion), or make the body "
            "heavier.";

@@ -1044,8 +1044,14 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
   const int n = N_ + 1;
   Nodes x(xp, 3, n), v(vp, 3, n);
   StepStatus status;
-  const int steps = SubstepsFor(dt);
+  int steps = SubstepsFor(dt);
   if (steps == 0) return status;
+  // explicit and rk4: more substeps where the drag at this advance's speeds needs them (not
+  // with a declared substeps or max_step: Tether::DragSubsteps).
+  if (IsExplicit(p_.integrator) && p_.substeps == 0 && !(p_.max_step > 0)) {
+    PlaceEnds(from, x, v);
+    steps = DragSubsteps(xp, vp, from, to, dt, steps);
+  }
   const double h = dt / steps;
   // bdf2 without a caller's history: one in the workspace for this call (x0, v0 are
   // implicit2's), starting with a backward-Euler step.

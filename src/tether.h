@@ -174,6 +174,12 @@ class Tether {
   double ExplicitStableStep() const { return explicit_dt_; }
   // Number of tether steps to cover dt [s] with the configured integrator.
   int SubstepsFor(double dt) const;
+  // explicit and rk4 with drag: the substeps over dt that the drag at the state's speeds
+  // needs (state x, v with the ends placed at `from`; the ends' speeds at from and to count),
+  // given `steps` from SubstepsFor: steps where the substep is within 0.9 of the drag's limit,
+  // more where it is not (see tether.cc).
+  int DragSubsteps(const double* x, const double* v, const Ends& from, const Ends& to,
+                   double dt, int steps) const;
 
   // Initial shape: a straight line when the ends are at least `length` apart, otherwise an
   // inextensible catenary of the right length in the vertical plane through both ends (sagging
@@ -377,6 +383,9 @@ class Tether {
   double L0_ = 0;               // [m] rest length of a segment
   double area_ = 0;             // [m^2] pi d^2 / 4
   double kn_ = 0, kt_ = 0;      // [kg/m^2] 1/2 rho Cdn d, 1/2 rho Cdt pi d (per length)
+  // [1/m] the largest drag rate per unit speed of a dynamic node, 2 max(kn/(m + ma), kt/m) l_i
+  // with l_i its rest share stretched to max_strain (DragSubsteps' quick test)
+  double drag_rate_per_speed_ = 0;
   double seabed_k_ = 0, seabed_c_ = 0;  // [N/m^2], [N s/m^2] per length
   double contact_k_ = 0, contact_c_ = 0;  // [N/m^2], [N s/m^2] per length
   double explicit_limit_ = 0;   // [s]
@@ -392,6 +401,9 @@ class Tether {
     Eigen::VectorXd inv_mass_normal;  // [1/kg] (n) 1/(m_i + ma_i)
     Eigen::VectorXd share;            // [m] (n) rest length lumped at each node
     Eigen::Matrix3Xd weight;          // [N] (3 x n) weight minus buoyancy per node
+    // The explicit stable step's terms per dynamic node (Create; 0 elsewhere): the bound on
+    // w [rad/s], the damping rate [1/s] and the node's limit [s] (DragSubsteps scales it).
+    Eigen::VectorXd stab_w, stab_rate, stab_h;
   };
   std::shared_ptr<const NodeArrays> arrays_;
   const double* mass_ = nullptr;  // arrays_ from this tether's node 0 on
