@@ -1046,12 +1046,9 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
   StepStatus status;
   int steps = SubstepsFor(dt);
   if (steps == 0) return status;
-  // explicit and rk4: more substeps where the drag at this advance's speeds needs them (not
-  // with a declared substeps or max_step: Tether::DragSubsteps).
-  if (IsExplicit(p_.integrator) && p_.substeps == 0 && !(p_.max_step > 0)) {
-    PlaceEnds(from, x, v);
-    steps = DragSubsteps(xp, vp, from, to, dt, steps);
-  }
+  PlaceEnds(from, x, v);
+  // explicit and rk4: more substeps where the drag at this advance's speeds needs them.
+  steps = DragSubsteps(xp, vp, from, to, dt, steps);
   const double h = dt / steps;
   // bdf2 without a caller's history: one in the workspace for this call (x0, v0 are
   // implicit2's), starting with a backward-Euler step.
@@ -1060,7 +1057,6 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
   const History hist = history ? History{history, history + 1, history + 1 + 3 * n}
                                : History{&h_prev, w.x0, w.v0};
   Ends now = from;
-  PlaceEnds(from, x, v);
   for (int k = 0; k < steps; ++k) {
     const Ends next = k + 1 == steps ? to : Interpolate(from, to, dt, double(k + 1) / steps);
     Step(x, v, now, next, h, work, &status, &hist);

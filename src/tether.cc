@@ -285,10 +285,8 @@ int Tether::DragSubsteps(const double* xp, const double* vp, const Ends& from, c
     return steps;
   }
   ConstNodes x(xp, 3, N_ + 1), v(vp, 3, N_ + 1);
-  const bool profile = Has(kCurrent) && !env_.water.profile.empty();
-  const Vec3 u0 = Has(kCurrent) ? env_.water.current : Vec3::Zero();
   auto relative = [&](const Vec3& p, const Vec3& vel) {
-    return ((profile ? env_.water.profile.At(p.z()) : u0) - vel).norm();
+    return ((Has(kCurrent) ? env_.water.CurrentAt(p.z()) : Vec3::Zero()) - vel).norm();
   };
   double s = std::max(relative(from.a.pos, from.a.vel), relative(to.a.pos, to.a.vel));
   if (!DynamicB()) {

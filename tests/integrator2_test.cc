@@ -86,14 +86,11 @@ TEST(Bdf2, KeepsThe5HzWaveWhereBackwardEulerDampsIt) {
   for (const char* integrator : {"bdf2", "implicit"}) {
     Environment env;
     env.gravity = Vec3::Zero();
-    DeclarationError e;
     std::ostringstream decl;
     decl << "ends=a,b length=" << L << " segments=" << N << " diameter=0.01 mass_per_length="
          << mu << " EA=" << EA << " integrator=" << integrator;
-    std::optional<TetherDeclaration> d = ParseTether(decl.str(), env, &e);
-    ASSERT_TRUE(d) << e.message;
     std::string error;
-    std::optional<Tether> t = Tether::Create(d->params, env, &error);
+    std::optional<Tether> t = reference_scenes::TetherFrom(decl.str(), env, &error);
     ASSERT_TRUE(t) << error;
     Ends ends;
     ends.a.pos = Vec3(0, 0, 0);
@@ -151,15 +148,12 @@ TEST(ImplicitSchemes, TheEndSegmentsDampingIsGalileanInvariant) {
       Environment env;
       env.wet = true;
       if (moving) env.water.current = U;
-      DeclarationError e;
       std::ostringstream decl;
       decl << "ends=a,b length=10 segments=" << N
            << " diameter=0.02 mass_per_length=0.5 EA=1e4 damping=20 Cdn=1.2 Cdt=0.01 Can=1"
            << " integrator=" << integrator;
-      std::optional<TetherDeclaration> d = ParseTether(decl.str(), env, &e);
-      ASSERT_TRUE(d) << e.message;
       std::string error;
-      std::optional<Tether> t = Tether::Create(d->params, env, &error);
+      std::optional<Tether> t = reference_scenes::TetherFrom(decl.str(), env, &error);
       ASSERT_TRUE(t) << error;
       const Vec3 u = moving ? U : Vec3::Zero();
       std::vector<double> x(3 * (N + 1)), v(3 * (N + 1)), work(t->WorkspaceSize());

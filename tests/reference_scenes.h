@@ -227,6 +227,19 @@ inline std::string LineModelXml(const Scene& s, int segments, const char* integr
   return x.str();
 }
 
+// A tether from a declaration's text in an environment: nullopt with *error set where the
+// declaration or the tether is refused.
+inline std::optional<Tether> TetherFrom(const std::string& declaration, const Environment& env,
+                                        std::string* error) {
+  DeclarationError e;
+  std::optional<TetherDeclaration> decl = ParseTether(declaration, env, &e);
+  if (!decl) {
+    *error = e.message;
+    return std::nullopt;
+  }
+  return Tether::Create(decl->params, env, error);
+}
+
 inline std::optional<Tether> MakeTether(const Scene& s, int N, const std::string& integrator,
                                  double max_step, int substeps, std::string* error) {
   Environment env;
@@ -242,14 +255,7 @@ inline std::optional<Tether> MakeTether(const Scene& s, int N, const std::string
     env.water = *w;
   }
   const std::string ends = s.b ? "ends=a,b " : "ends=a,free ";
-  DeclarationError e;
-  std::optional<TetherDeclaration> decl =
-      ParseTether(ends + Declaration(s, N, integrator, max_step, substeps), env, &e);
-  if (!decl) {
-    *error = e.message;
-    return std::nullopt;
-  }
-  return Tether::Create(decl->params, env, error);
+  return TetherFrom(ends + Declaration(s, N, integrator, max_step, substeps), env, error);
 }
 
 inline Ends EndsAt(const Scene& s, double t) {

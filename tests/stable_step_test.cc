@@ -165,14 +165,11 @@ TEST(DragStep, ExplicitSchemesSubstepForTheDragOfAFastCurrent) {
   const double span = 98, dt = 0.002, duration = 1.5;  // [m], [s], [s]
   std::vector<double> deflection;
   for (const char* integrator : {"implicit", "explicit", "rk4"}) {
-    DeclarationError e;
     std::ostringstream decl;
     decl << "ends=a,b length=98.03 segments=2 diameter=0.0064 mass_per_length=0.091 EA=3e8"
          << " Cdn=1.2 Cdt=0.01 Can=1 integrator=" << integrator;
-    std::optional<TetherDeclaration> d = ParseTether(decl.str(), env, &e);
-    ASSERT_TRUE(d) << e.message;
     std::string error;
-    std::optional<Tether> t = Tether::Create(d->params, env, &error);
+    std::optional<Tether> t = reference_scenes::TetherFrom(decl.str(), env, &error);
     ASSERT_TRUE(t) << error;
     Ends ends;
     ends.a.pos = Vec3(0, 0, 0);
