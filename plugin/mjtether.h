@@ -113,7 +113,7 @@ constexpr double kCouplingLimitImplicit2 = 1.0;
 // as likely off its fine-step self, and to which the chatter message's advised step brings it.
 // Session 19, the long run of session 18 (seeds 201-10000, runs that went to their end): the
 // held force disagreed with its 10x smaller step in 7 of 629 explicit runs below 0.1 (1.1%)
-// and 16 of 247 at 0.1-0.5 (6.5%); rk4 5 of 705 below 0.2, 10 of 179 at 0.2-0.8; implicit2 9
+// and 16 of 247 at 0.1-0.5 (6.5%); rk4 5 of 705 below 0.2, 10 of 179 at 0.2-0.8; implicit2 5
 // of 557 below 0.1, 13 of 210 at 0.1-0.5. Scene fuzzer seed 3244 (explicit, a 326 kg vehicle
 // drifting with a 2 m/s current on 4 segments of EA 2.7e8 N) at a 1 ms step, omega h 0.2498:
 // its end tension rang from 16 N to 18 kN within 1 s and the run ended with exit 0; at 0.4 ms
