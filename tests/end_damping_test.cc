@@ -16,6 +16,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <sstream>
 #include <string>
 
@@ -113,6 +114,76 @@ TEST_P(EndDamping, BelowTheLimitSpeedRunsWithoutAStopOrAWarning) {
   mju_user_warning = previous;
   EXPECT_EQ(g_warnings, 0);
   EXPECT_FALSE(o.stopped) << o.message;
+}
+
+// Scene fuzzer seed 227: a 204 kg vehicle pushed by a thrust schedule ramping to 1.98e8 N on
+// 2 segments that hold EA x max_strain = 1.1e8 N. At 2 ms the drag of the runaway vehicle
+// (338 m/s) trips the end-damping stop at t = 0.162 s. Its cause is the thrust, which the
+// message names with its cure and with the claim that a smaller step would diverge later;
+// until session 19 the message went on to repeat the cure and the claim. Checked here: the
+// cause once, no step offered, and the claim itself: the same scene at 0.2 ms stops too.
+std::string Seed227(double timestep) {
+  std::ostringstream x;
+  x << "<mujoco><option timestep=\"" << timestep << "\"/><custom>"
+    << "<text name=\"water\" data=\"density=1025 current=-1.238841005,-1.353277355,0 "
+       "seabed=-65.02469748\"/>"
+    << "<text name=\"vehicle:rov\" data=\"volume=0.2031404722 cob=0,0,0.05887362465 "
+       "added_mass=71.82324002,88.75734816,152.2374175,3.536501754,3.536501754,3.536501754 "
+       "linear_damping=246.3563963,246.3563963,246.3563963,11.78833918,11.78833918,"
+       "11.78833918 quadratic_damping=177.6378136,177.6378136,177.6378136,11.78833918,"
+       "11.78833918,11.78833918 coriolis=0\"/>"
+    << "<text name=\"tether:t\" data=\"ends=tms_site,att length=145.7146796 segments=2 "
+       "diameter=0.03983075026 mass_per_length=1.653954031 EA=110006059.8 Cdn=1.2 Cdt=0.01 "
+       "Can=1 integrator=implicit\"/>"
+    << "<text name=\"thrust:thr\" data=\"t=0.1,0.4 ctrl=0,198079947.6\"/>"
+    << "</custom><worldbody><body name=\"tms\" mocap=\"true\"><site name=\"tms_site\"/></body>"
+    << "<body name=\"rov\" pos=\"-41.57642229 18.7001488 -42.22438641\"><freejoint/>"
+    << "<inertial pos=\"0 0 0\" mass=\"204.062087\" diaginertia=\"11.78833918 11.78833918 "
+       "11.78833918\"/><site name=\"att\"/><site name=\"thr\"/></body></worldbody>"
+    << "<actuator><motor name=\"thr\" site=\"thr\" gear=\"-0.7972904868 -0.0899713724 "
+       "-0.5968526047 0 0 0\"/></actuator></mujoco>";
+  return x.str();
+}
+
+// Runs 1 s or to a stop; the stop's message ("" if none).
+std::string StopOf(const std::string& xml) {
+  std::string error;
+  mjModel* m = LoadModelFromString(xml, "seed227.xml", &error);
+  EXPECT_NE(m, nullptr) << error;
+  if (!m) return "";
+  mjData* d = mj_makeData(m);
+  std::string stop;
+  const long long steps = std::llround(1.0 / m->opt.timestep);
+  for (long long k = 0; k < steps && stop.empty(); ++k) {
+    Step(m, d);
+    if (std::optional<std::string> msg = CheckDivergence(m, d)) stop = *msg;
+  }
+  mj_deleteData(d);
+  Detach(m);
+  mj_deleteModel(m);
+  return stop;
+}
+
+size_t Count(const std::string& text, const std::string& part) {
+  size_t n = 0;
+  for (size_t at = text.find(part); at != std::string::npos; at = text.find(part, at + 1)) ++n;
+  return n;
+}
+
+TEST(EndDampingCause, AThrustBeyondWhatTheTetherHoldsIsNamedOnceWithoutAStep) {
+  const std::string stop = StopOf(Seed227(0.002));
+  std::printf("%s\n", stop.c_str());
+  ASSERT_NE(stop.find("its end B damping too stiff for the step of body 'rov'"),
+            std::string::npos) << stop;
+  EXPECT_NE(stop.find("It was driven there by: thrust beyond what the tether holds"),
+            std::string::npos) << stop;
+  EXPECT_EQ(Count(stop, "thrust beyond what the tether holds"), 1u) << stop;
+  EXPECT_EQ(Count(stop, "a smaller step would probably diverge too, later"), 1u) << stop;
+  EXPECT_EQ(stop.find("<option timestep>"), std::string::npos) << stop;
+  EXPECT_EQ(stop.find("Reduce what drives"), std::string::npos) << stop;
+  EXPECT_EQ(stop.back(), '.') << stop;
+  // The claim: at a tenth of the step the run stops as well (later or not, but it stops).
+  EXPECT_NE(StopOf(Seed227(0.0002)), "");
 }
 
 INSTANTIATE_TEST_SUITE_P(Integrators, EndDamping,
