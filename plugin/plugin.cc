@@ -1770,7 +1770,7 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
           << (end == 0 ? "A" : "B") << " on body '" << (body ? body : "?")
           << "': held end force at coupling omega h = " << c.omega_h << " (omega = " << c.omega
           << " rad/s, <option timestep> " << h << " s), at or above " << kCouplingAccurate
-          << ", where the scene fuzzer finds 1 in 15 such runs off their 10x smaller step "
+          << ", where the scene fuzzer finds 1 in 20 such runs off their 10x smaller step "
           << "(an end-force chatter can grow without a stop); use integrator=bdf2 (the "
           << "default) or implicit (the end node is solved with the body), or <option "
           << "timestep> <= " << kCouplingAccurate / c.omega << " s";

@@ -1528,7 +1528,7 @@ void RunScenes(const std::vector<SceneId>& list, const std::set<SceneId>& known,
            << ", EA=" << s.EA << ", m=" << s.mass << " kg, omega*h=" << s.omega_h
            << ", seabed kind " << s.seabed_kind << ", thrust/holds=" << s.thrust / s.holds()
            << Describe(s) << "]: " << (o.pass ? "pass" : "FAIL") << ": " << o.kind << ": "
-           << o.detail;
+           << o.detail << (o.held ? " [warned at load: held end force]" : "");
       std::lock_guard<std::mutex> lock(mutex);
       ++counts[(o.pass ? "pass  " : "FAIL  ") + o.kind];
       if (o.shortened) ++counts["(of these, run shortened below 1 s by the cost budget)"];
