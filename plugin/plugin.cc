@@ -1744,9 +1744,12 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
       c.applies = c.limit > 0;
       if (!c.applies) continue;
       const char* body = mj_id2name(m, mjOBJ_BODY, c.body);
+      // Both warnings and the refusal start with the integrator, the end and its body.
+      const std::string head = std::string("integrator=") + IntegratorName(p.integrator) +
+                               " with end " + (end == 0 ? "A" : "B") + " on body '" +
+                               (body ? body : "?") + "': ";
       std::ostringstream s;
-      s << "integrator=" << IntegratorName(p.integrator) << " with end " << (end == 0 ? "A" : "B")
-        << " on body '" << (body ? body : "?") << "': coupling omega h = " << c.omega_h
+      s << head << "coupling omega h = " << c.omega_h
         << " (omega = sqrt(k_end/m_eff) = sqrt(" << c.k_end << " N/m / " << c.m_eff
         << " kg) = " << c.omega << " rad/s, <option timestep> " << h << " s), limit " << c.limit
         << (p.integrator == Integrator::kImplicit2
@@ -1766,9 +1769,8 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
       } else if (!c.consistent && c.omega_h >= kCouplingAccurate) {
         // Below half the limit, but where the held force is often off (kCouplingAccurate).
         std::ostringstream w;
-        w << where << "integrator=" << IntegratorName(p.integrator) << " with end "
-          << (end == 0 ? "A" : "B") << " on body '" << (body ? body : "?")
-          << "': held end force at coupling omega h = " << c.omega_h << " (omega = " << c.omega
+        w << where << head << "held end force at coupling omega h = " << c.omega_h
+          << " (omega = " << c.omega
           << " rad/s, <option timestep> " << h << " s), at or above " << kCouplingAccurate
           << ", where the scene fuzzer finds 1 in 20 such runs off their 10x smaller step "
           << "(an end-force chatter can grow without a stop); use integrator=bdf2 (the "

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <optional>
@@ -54,13 +55,14 @@ struct Sample {
   double tension;       // [N] at the vehicle's end
 };
 
-// Runs the scene for `duration` s, sampling every 0.05 s; stops at a divergence or chatter
-// report, returned in *stopped.
-inline std::vector<Sample> RunScene(mjModel* m, double duration, std::string* stopped) {
+// Runs the scene for `duration` s, sampling every `interval` s (0.05 s unless given; at least
+// every step); stops at a divergence or chatter report, returned in *stopped.
+inline std::vector<Sample> RunScene(mjModel* m, double duration, std::string* stopped,
+                                    double interval = 0.05) {
   mjData* d = mj_makeData(m);
   const int rov = mj_name2id(m, mjOBJ_BODY, "rov");
   const long long steps = std::llround(duration / m->opt.timestep);
-  const long long every = std::llround(0.05 / m->opt.timestep);
+  const long long every = std::max(1LL, std::llround(interval / m->opt.timestep));
   std::vector<Sample> out;
   for (long long i = 0; i <= steps; ++i) {
     Prescribe(m, d);

@@ -341,27 +341,14 @@ std::string Seed3244Xml(const std::string& integrator, double timestep) {
          "</worldbody></mujoco>";
 }
 
-// The vehicle-end tension averaged over the last `window` s of `duration` s [N]; "" in
-// *stopped unless the run stopped.
+// The vehicle-end tension averaged over the last `window` s of `duration` s [N], from
+// RunScene's samples at every step; "" in *stopped unless the run stopped.
 double MeanEndTension(mjModel* m, double duration, double window, std::string* stopped) {
-  mjData* d = mj_makeData(m);
-  const long long steps = std::llround(duration / m->opt.timestep);
-  const long long from = steps - std::llround(window / m->opt.timestep);
+  const std::vector<Sample> samples = RunScene(m, duration, stopped, m->opt.timestep);
+  const size_t w = std::min(samples.size(), size_t(std::llround(window / m->opt.timestep)));
   double sum = 0;
-  for (long long i = 1; i <= steps; ++i) {
-    Prescribe(m, d);
-    mj_step(m, d);
-    if (std::optional<std::string> s = CheckDivergence(m, d)) {
-      *stopped = *s;
-      break;
-    }
-    if (i > from) {
-      mj_forward(m, d);
-      sum += GetReactions(m, d, 0).tension_b;
-    }
-  }
-  mj_deleteData(d);
-  return sum / double(steps - from);
+  for (size_t i = samples.size() - w; i < samples.size(); ++i) sum += samples[i].tension;
+  return sum / double(w);
 }
 
 bool WarnsHeldForce(const mjModel* m) {
