@@ -330,8 +330,8 @@ std::function<int()> SetupRun(CLI::App* sub) {
                   "significant digits of the CSV numbers (default 9; 17 is exact)")
       ->check(CLI::Range(1, 17));
   sub->add_option("--set", opt->set,
-                  "override one declaration key, TEXT.KEY=VALUE (e.g. water.current=0.5,0,0); "
-                  "repeatable")
+                  "override one declaration key, TEXT.KEY=VALUE (e.g. water.current=0.5,0,0), "
+                  "or the step, option.timestep=SECONDS; repeatable")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   sub->add_option("--summary", opt->summary,

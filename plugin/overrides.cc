@@ -9,9 +9,13 @@
 #include <sstream>
 
 #include "mjtether.h"
+#include "text_check.h"
 
 namespace mjtether {
 namespace {
+
+// The name that stands for MuJoCo's <option> in an override ("option.timestep=0.0005").
+constexpr char kOptionText[] = "option";
 
 bool StartsWith(const std::string& s, size_t at, const char* prefix) {
   return s.compare(at, std::strlen(prefix), prefix) == 0;
@@ -284,6 +288,29 @@ std::optional<std::string> ApplyOverrides(const std::string& xml,
 mjModel* LoadModel(const std::string& path, const std::vector<Override>& overrides,
                    std::string* error) {
   if (overrides.empty()) return LoadModel(path, error);
+  // option.timestep: MuJoCo's <option timestep>, set on the compiled model before Attach, so
+  // that the load-time checks and advice (coupling omega h, stable steps, warnings) see it.
+  std::vector<Override> texts;
+  double timestep = 0;  // [s] 0: not overridden
+  for (const Override& o : overrides) {
+    if (o.text != kOptionText) {
+      texts.push_back(o);
+      continue;
+    }
+    const std::string spec = o.text + "." + o.key + "=" + o.value;
+    if (o.key != "timestep") {
+      *error = path + ": '" + Shown(spec) + "': of <option>, only timestep can be overridden " +
+               "(option.timestep=SECONDS)";
+      return nullptr;
+    }
+    const NumberStatus status = ParseDecimal(o.value, &timestep);
+    if (status != NumberStatus::kOk || !(timestep > 0 && timestep <= 1)) {
+      *error = path + ": '" + Shown(spec) + "': " +
+               (status == NumberStatus::kOk ? "is out of range" : NumberProblem(status)) +
+               "; allowed: (0, 1] s (MuJoCo's <option timestep>)";
+      return nullptr;
+    }
+  }
   std::ifstream f(path, std::ios::binary);
   std::stringstream s;
   s << f.rdbuf();
@@ -292,7 +319,7 @@ mjModel* LoadModel(const std::string& path, const std::vector<Override>& overrid
     return nullptr;
   }
   std::string message;
-  std::optional<std::string> xml = ApplyOverrides(s.str(), overrides, &message);
+  std::optional<std::string> xml = ApplyOverrides(s.str(), texts, &message);
   if (!xml) {
     *error = path + ": " + message;
     return nullptr;
@@ -319,6 +346,7 @@ mjModel* LoadModel(const std::string& path, const std::vector<Override>& overrid
     *error = path + ": " + buffer;
     return nullptr;
   }
+  if (timestep > 0) m->opt.timestep = timestep;
   if (!Attach(m, path, error)) {
     mj_deleteModel(m);
     return nullptr;

@@ -11,6 +11,12 @@
 // the file, the element and the key. The edited text is loaded from memory under the file's
 // own path, so <include>, meshes and motion csv files resolve relative to the model as before.
 // Only <text> elements of the top-level file can be overridden (not of an <include>d file).
+//
+// One name is not a <text>: `option.timestep=SECONDS` sets MuJoCo's <option timestep> (in
+// (0, 1] s) on the compiled model before the tethers are attached, so that the load-time
+// checks and advice see the new step. It is how a run is compared with itself at a smaller
+// step, as the advisor's messages suggest, without editing the file (a <text name="option">
+// cannot be overridden). No other <option> attribute can.
 #ifndef MJTETHER_PLUGIN_OVERRIDES_H_
 #define MJTETHER_PLUGIN_OVERRIDES_H_
 
