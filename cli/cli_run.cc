@@ -1,7 +1,7 @@
 // `mjtether run` and `mjtether info`.
 //
 //   mjtether run MODEL.xml --duration S [--log FILE.csv] [--nodes FILE.csv] [--every S]
-//   mjtether info MODEL.xml
+//   mjtether info MODEL.xml [--set TEXT.KEY=VALUE]...
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -47,20 +47,30 @@ std::string BodyName(const mjModel* m, int b) {
   return name && *name ? name : "body" + std::to_string(b);
 }
 
+// The --set options as overrides (overrides.h); false after naming the first bad one.
+bool ParseSets(const std::vector<std::string>& set, std::vector<mjtether::Override>* out) {
+  for (const std::string& spec : set) {
+    std::string why;
+    std::optional<mjtether::Override> o = mjtether::ParseOverride(spec, &why);
+    if (!o) {
+      std::cerr << "mjtether: --set " << why << "\n";
+      return false;
+    }
+    out->push_back(*o);
+  }
+  return true;
+}
+
+const char kSetHelp[] =
+    "override one declaration key, TEXT.KEY=VALUE (e.g. water.current=0.5,0,0), or the step, "
+    "option.timestep=SECONDS; repeatable";
+
 int Run(const RunOptions& opt) {
   using namespace mjtether::cli;
   using mjtether::CsvField;
   InstallStopHandlers();
   std::vector<mjtether::Override> overrides;
-  for (const std::string& spec : opt.set) {
-    std::string why;
-    std::optional<mjtether::Override> o = mjtether::ParseOverride(spec, &why);
-    if (!o) {
-      std::cerr << "mjtether: --set " << why << "\n";
-      return kExitBadInput;
-    }
-    overrides.push_back(*o);
-  }
+  if (!ParseSets(opt.set, &overrides)) return kExitBadInput;
   ModelPtr m = LoadChecked(opt.model, overrides);
   if (!m) return kExitBadInput;
   // Every output is claimed and opened (as a temporary file) before the run: a bad second path
@@ -231,8 +241,10 @@ int Run(const RunOptions& opt) {
   return status;
 }
 
-int Info(const std::string& path) {
-  mjtether::cli::ModelPtr owner = mjtether::cli::LoadChecked(path);
+int Info(const std::string& path, const std::vector<std::string>& set) {
+  std::vector<mjtether::Override> overrides;
+  if (!ParseSets(set, &overrides)) return mjtether::cli::kExitBadInput;
+  mjtether::cli::ModelPtr owner = mjtether::cli::LoadChecked(path, overrides);
   if (!owner) return mjtether::cli::kExitBadInput;
   const mjModel* m = owner.get();
   std::cout << path << ": timestep " << m->opt.timestep << " s, "
@@ -329,9 +341,7 @@ std::function<int()> SetupRun(CLI::App* sub) {
   sub->add_option("--digits", opt->digits,
                   "significant digits of the CSV numbers (default 9; 17 is exact)")
       ->check(CLI::Range(1, 17));
-  sub->add_option("--set", opt->set,
-                  "override one declaration key, TEXT.KEY=VALUE (e.g. water.current=0.5,0,0), "
-                  "or the step, option.timestep=SECONDS; repeatable")
+  sub->add_option("--set", opt->set, kSetHelp)
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   sub->add_option("--summary", opt->summary,
@@ -341,8 +351,13 @@ std::function<int()> SetupRun(CLI::App* sub) {
 
 std::function<int()> SetupInfo(CLI::App* sub) {
   auto model = std::make_shared<std::string>();
+  auto set = std::make_shared<std::vector<std::string>>();
   sub->add_option("model", *model, "MJCF file")->required()->check(CLI::ExistingFile);
-  return [model]() { return Info(*model); };
+  // The same overrides as run: what the advisor says at another step or with another EA.
+  sub->add_option("--set", *set, kSetHelp)
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  return [model, set]() { return Info(*model, *set); };
 }
 
 const bool registered_run =

@@ -163,7 +163,8 @@ std::string LightVehicleScene(const std::string& step) {
 // it (the coupling changes from consistent to held with the step), and `run --set
 // option.timestep=0.001` writes the same log, byte for byte, as the file edited by hand to
 // 0.001 (set after the attachment, the run would keep the consistent coupling of 2 ms and
-// differ); a sweep column of that name does the same.
+// differ); `info --set` prints the advice at that step; a sweep column of that name does the
+// same as run.
 TEST(Overrides, TimestepIsSetBeforeTheTethersAreAttached) {
   const std::string dir = TempFolder("timestep");
   Write(dir + "/light.xml", LightVehicleScene("0.002"));
@@ -203,6 +204,13 @@ TEST(Overrides, TimestepIsSetBeforeTheTethersAreAttached) {
   EXPECT_GT(by_set.size(), 1000u);
   EXPECT_EQ(by_set, Read(dir + "/hand.csv"));
   EXPECT_NE(by_set, Read(dir + "/file.csv"));  // the step matters here
+
+  // `info --set` prints the advice at that step.
+  ASSERT_EQ(RunCli("info " + dir + "/light.xml --set option.timestep=0.001", &output), 0) << output;
+  EXPECT_TRUE(Contains(output, "timestep 0.001 s")) << output;
+  EXPECT_TRUE(Contains(output, "held end force")) << output;
+  ASSERT_EQ(RunCli("info " + dir + "/light.xml", &output), 0) << output;
+  EXPECT_TRUE(Contains(output, "consistent coupling")) << output;
 
   Write(dir + "/manifest.csv", "id,model,duration,option.timestep\nfine,light.xml,0.5,0.001\n");
   ASSERT_EQ(RunCli("sweep " + dir + "/manifest.csv --out " + dir + "/out --every 0.01", &output),
