@@ -37,6 +37,17 @@ inline void SetNodes(const mjModel* m, const mjData* d, const Eigen::Matrix3Xd& 
   for (int i = 0; i < 3 * n; ++i) xp[3 * n + i] = 0;
 }
 
+// Steps (mjtether::Step: motions and thrust schedules applied) until a tether reports a
+// divergence or d->time reaches `seconds`: the divergence message, or nullopt.
+inline std::optional<std::string> StepUntilDivergence(const mjModel* m, mjData* d,
+                                                      double seconds) {
+  while (d->time < seconds) {
+    Step(m, d);
+    if (std::optional<std::string> message = CheckDivergence(m, d)) return message;
+  }
+  return std::nullopt;
+}
+
 inline void FailOnWarning(const char* message) {
   ADD_FAILURE() << "MuJoCo warning: " << message;
 }

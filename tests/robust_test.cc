@@ -211,25 +211,16 @@ std::string StiffBendingXml(const std::string& integrator) {
 </worldbody></mujoco>)";
 }
 
-// Steps until a divergence is reported or `duration` [s] has passed; the message or nullopt.
-std::optional<std::string> RunUntilStop(const mjModel* m, mjData* d, double duration) {
-  while (d->time < duration - 1e-9) {
-    mj_step(m, d);
-    if (std::optional<std::string> stop = CheckDivergence(m, d)) return stop;
-  }
-  return std::nullopt;
-}
-
 TEST_F(Scene, Implicit2StoppedWhereTheOtherImplicitSchemesRunIsToldToUseThem) {
   mjModel* m = Load(StiffBendingXml("implicit2"), "scene9828.xml");
-  std::optional<std::string> stop = RunUntilStop(m, Make(m), 1);
+  std::optional<std::string> stop = testing::StepUntilDivergence(m, Make(m), 1);
   ASSERT_TRUE(stop) << "implicit2 ran 1 s at 1 ms";
   EXPECT_TRUE(Contains(*stop, "Reduce <option timestep> (now 0.001 s)")) << *stop;
   EXPECT_TRUE(Contains(*stop, "or use integrator=bdf2 (the default) or implicit")) << *stop;
   for (const char* other : {"bdf2", "implicit"}) {
     mjModel* o = Load(StiffBendingXml(other), std::string("scene9828_") + other + ".xml");
     mjData* d = Make(o);
-    const std::optional<std::string> other_stop = RunUntilStop(o, d, 1);
+    const std::optional<std::string> other_stop = testing::StepUntilDivergence(o, d, 1);
     EXPECT_FALSE(other_stop) << other << ": " << *other_stop;
     EXPECT_NEAR(d->time, 1, 1e-9) << other;
   }

@@ -19,6 +19,7 @@ namespace mjtether {
 namespace {
 
 using testing::MuJoCoFixture;
+using testing::StepUntilDivergence;
 
 bool Contains(const std::string& s, const std::string& part) {
   return s.find(part) != std::string::npos;
@@ -232,12 +233,7 @@ class StartUpDivergence : public MuJoCoFixture {
  protected:
   std::string RunUntilDivergence(const std::string& xml, double seconds) {
     mjModel* m = Load(xml, "scene.xml");
-    mjData* d = Make(m);
-    while (d->time < seconds) {
-      Step(m, d);
-      if (std::optional<std::string> message = CheckDivergence(m, d)) return *message;
-    }
-    return "";
+    return StepUntilDivergence(m, Make(m), seconds).value_or("");
   }
 };
 
