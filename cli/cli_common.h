@@ -66,8 +66,9 @@ inline DataPtr MakeData(const mjModel* m) { return DataPtr(mj_makeData(m)); }
 inline std::optional<std::string> CheckModelNumbers(const mjModel* m, const std::string& path) {
   std::ostringstream s;
   const double h = m->opt.timestep;
-  if (!(h > 0 && h <= 1)) {
-    s << path << ": <option timestep=\"" << h << "\">: the time step must be in (0, 1] s";
+  if (!(h > 0 && h <= mjtether::kMaxTimestep)) {
+    s << path << ": <option timestep=\"" << h << "\">: the time step must be in (0, "
+      << mjtether::kMaxTimestep << "] s";
     return s.str();
   }
 #define X(type, name)                                                                   \

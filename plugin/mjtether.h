@@ -120,6 +120,9 @@ constexpr double kCouplingLimitImplicit2 = 1.0;
 // (omega h 0.1) it reads 15.8 N, as bdf2 does at 1 ms. 0.25 until session 19 (from session
 // 10's figures), which advised that very 1 ms step.
 constexpr double kCouplingAccurate = 0.1;
+// [s] The largest <option timestep> the command line runs (CheckModelNumbers) and an override
+// option.timestep accepts (overrides.h); the step must also be above 0.
+constexpr double kMaxTimestep = 1;
 // Estimated CPU time [s] the tether takes per simulated second at MuJoCo step `timestep`, from
 // its tether steps and nodes and the per-node costs measured on this project's machine.
 double EstimatedCostPerSecond(const Tether& t, double timestep);

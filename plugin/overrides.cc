@@ -304,10 +304,12 @@ mjModel* LoadModel(const std::string& path, const std::vector<Override>& overrid
       return nullptr;
     }
     const NumberStatus status = ParseDecimal(o.value, &timestep);
-    if (status != NumberStatus::kOk || !(timestep > 0 && timestep <= 1)) {
+    if (status != NumberStatus::kOk || !(timestep > 0 && timestep <= kMaxTimestep)) {
+      std::ostringstream allowed;
+      allowed << "; allowed: (0, " << kMaxTimestep << "] s (MuJoCo's <option timestep>)";
       *error = path + ": '" + Shown(spec) + "': " +
                (status == NumberStatus::kOk ? "is out of range" : NumberProblem(status)) +
-               "; allowed: (0, 1] s (MuJoCo's <option timestep>)";
+               allowed.str();
       return nullptr;
     }
   }
