@@ -113,6 +113,33 @@ inline std::optional<std::string> CheckModelNumbers(const mjModel* m, const std:
   return std::nullopt;
 }
 
+// The --set options as overrides (overrides.h); false after naming the first bad one. Every
+// sub-command that loads a model (run, info, render, view) takes them, so that what is rendered
+// or viewed is the scene that was run.
+inline bool ParseSets(const std::vector<std::string>& set, std::vector<mjtether::Override>* out) {
+  for (const std::string& spec : set) {
+    std::string why;
+    std::optional<mjtether::Override> o = mjtether::ParseOverride(spec, &why);
+    if (!o) {
+      std::cerr << "mjtether: --set " << why << "\n";
+      return false;
+    }
+    out->push_back(*o);
+  }
+  return true;
+}
+
+inline constexpr char kSetHelp[] =
+    "override one declaration key, TEXT.KEY=VALUE (e.g. water.current=0.5,0,0), or the step, "
+    "option.timestep=SECONDS; repeatable";
+
+// Adds --set to a sub-command (kSetHelp; each occurrence one override).
+inline void AddSetOption(CLI::App* sub, std::vector<std::string>* set) {
+  sub->add_option("--set", *set, kSetHelp)
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+}
+
 // Loads and attaches a model and checks its numbers; prints the error and the advisor's
 // warnings. Null on failure (exit 2).
 inline ModelPtr LoadChecked(const std::string& path,

@@ -4,7 +4,7 @@
 //   mjtether render MODEL.xml --duration S --video out.mp4 [--fps 30] [--size 1280x720]
 //       [--camera follow|top|track:BODY|NAME] [--png-every S DIR] [--samples N]
 //       [--tension-max N|auto] [--distance M|auto] [--speedup X] [--vehicle BODY] [--no-hud]
-//       [--render-threads N|auto]
+//       [--render-threads N|auto] [--set TEXT.KEY=VALUE]...
 //
 // Frame k shows the state at step round(k / (fps h)), h the model's timestep: frames are
 // scheduled by index, so they never drift from t = k/fps by more than h/2 however long the
@@ -55,6 +55,7 @@ struct RenderCliOptions {
   std::string vehicle;
   bool no_hud = false;
   int render_threads = 0;  // 0: automatic, 1: serial
+  std::vector<std::string> set;  // TEXT.KEY=VALUE overrides, as for run (overrides.h)
 };
 
 // "auto" for --tension-max and --distance: stored as 0, the value that means automatic.
@@ -155,7 +156,9 @@ int Render(const RenderCliOptions& opt) {
   ropt.hud = !opt.no_hud;
 
   std::string error;
-  ModelPtr owner = LoadChecked(opt.model);
+  std::vector<mjtether::Override> overrides;
+  if (!ParseSets(opt.set, &overrides)) return kExitBadInput;
+  ModelPtr owner = LoadChecked(opt.model, overrides);
   if (!owner) return kExitBadInput;
   mjModel* m = owner.get();
 
@@ -377,6 +380,7 @@ std::function<int()> SetupRender(CLI::App* sub) {
                   "fps x speedup; default 1)")
       ->check(mjtether::cli::Number(0.01, 1000, false, ""));
   sub->add_option("--vehicle", opt->vehicle, "body whose depth the HUD shows");
+  mjtether::cli::AddSetOption(sub, &opt->set);
   sub->add_flag("--no-hud", opt->no_hud, "no text overlay or colour scale");
   sub->add_option("--render-threads", opt->render_threads,
                   "frames rendered in parallel, each with its own OSMesa context: 1 renders "

@@ -47,24 +47,6 @@ std::string BodyName(const mjModel* m, int b) {
   return name && *name ? name : "body" + std::to_string(b);
 }
 
-// The --set options as overrides (overrides.h); false after naming the first bad one.
-bool ParseSets(const std::vector<std::string>& set, std::vector<mjtether::Override>* out) {
-  for (const std::string& spec : set) {
-    std::string why;
-    std::optional<mjtether::Override> o = mjtether::ParseOverride(spec, &why);
-    if (!o) {
-      std::cerr << "mjtether: --set " << why << "\n";
-      return false;
-    }
-    out->push_back(*o);
-  }
-  return true;
-}
-
-const char kSetHelp[] =
-    "override one declaration key, TEXT.KEY=VALUE (e.g. water.current=0.5,0,0), or the step, "
-    "option.timestep=SECONDS; repeatable";
-
 int Run(const RunOptions& opt) {
   using namespace mjtether::cli;
   using mjtether::CsvField;
@@ -243,7 +225,7 @@ int Run(const RunOptions& opt) {
 
 int Info(const std::string& path, const std::vector<std::string>& set) {
   std::vector<mjtether::Override> overrides;
-  if (!ParseSets(set, &overrides)) return mjtether::cli::kExitBadInput;
+  if (!mjtether::cli::ParseSets(set, &overrides)) return mjtether::cli::kExitBadInput;
   mjtether::cli::ModelPtr owner = mjtether::cli::LoadChecked(path, overrides);
   if (!owner) return mjtether::cli::kExitBadInput;
   const mjModel* m = owner.get();
@@ -341,9 +323,7 @@ std::function<int()> SetupRun(CLI::App* sub) {
   sub->add_option("--digits", opt->digits,
                   "significant digits of the CSV numbers (default 9; 17 is exact)")
       ->check(CLI::Range(1, 17));
-  sub->add_option("--set", opt->set, kSetHelp)
-      ->expected(1)
-      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  mjtether::cli::AddSetOption(sub, &opt->set);
   sub->add_option("--summary", opt->summary,
                   "CSV row: peak tension over every step, the vehicle's final pose");
   return [opt]() { return Run(*opt); };
@@ -354,9 +334,7 @@ std::function<int()> SetupInfo(CLI::App* sub) {
   auto set = std::make_shared<std::vector<std::string>>();
   sub->add_option("model", *model, "MJCF file")->required()->check(CLI::ExistingFile);
   // The same overrides as run: what the advisor says at another step or with another EA.
-  sub->add_option("--set", *set, kSetHelp)
-      ->expected(1)
-      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  mjtether::cli::AddSetOption(sub, set.get());
   return [model, set]() { return Info(*model, *set); };
 }
 

@@ -4,7 +4,7 @@
 //
 //   mjtether view MODEL.xml [--size 1280x720] [--camera follow|top|track:BODY|NAME] [--samples N]
 //       [--tension-max N|auto] [--vehicle BODY] [--speed X] [--overlay] [--no-hud]
-//       [--screenshot FILE.png --frames N] [--keys K1,K2,...]
+//       [--screenshot FILE.png --frames N] [--keys K1,K2,...] [--set TEXT.KEY=VALUE]...
 //
 // Keys: space pause/run, right arrow one step (pauses), backspace reset, + and - double or
 // halve the speed, O the node and tension overlay, H the HUD, C back to the scene's camera,
@@ -51,6 +51,7 @@ struct ViewCliOptions {
   std::string screenshot;
   int frames = 0;
   std::string keys;
+  std::vector<std::string> set;  // TEXT.KEY=VALUE overrides, as for run (overrides.h)
 };
 
 constexpr double kFrameDt = 1.0 / 60;  // [s] simulated per frame with --frames (times speed)
@@ -262,7 +263,9 @@ int View(const ViewCliOptions& opt) {
   ropt.hud = !opt.no_hud;
   ropt.overlay = opt.overlay;
 
-  ModelPtr owner = LoadChecked(opt.model);
+  std::vector<mjtether::Override> overrides;
+  if (!ParseSets(opt.set, &overrides)) return kExitBadInput;
+  ModelPtr owner = LoadChecked(opt.model, overrides);
   if (!owner) return kExitBadInput;
   mjModel* m = owner.get();
   OutputGuard guard;
@@ -415,6 +418,7 @@ std::function<int()> SetupView(CLI::App* sub) {
           },
           "auto", ""));
   sub->add_option("--vehicle", opt->vehicle, "body whose depth the HUD shows");
+  AddSetOption(sub, &opt->set);
   sub->add_option("--speed", opt->speed,
                   "simulated seconds per second at the start (+ and - double and halve it)")
       ->check(mjtether::cli::Number(kMinSpeed, kMaxSpeed, false, ""));

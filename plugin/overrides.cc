@@ -285,6 +285,18 @@ std::optional<std::string> ApplyOverrides(const std::string& xml,
   return out;
 }
 
+// For a refusal of the edited file: the overrides of the <text> elements it names, so that a
+// value the file does not hold is not looked for there (" (from the override tether:u.EA=-5)").
+std::string OverridesNamed(const std::string& error, const std::vector<Override>& overrides) {
+  std::string named;
+  for (const Override& o : overrides) {
+    if (o.text == kOptionText) continue;
+    if (error.find("<text name=\"" + o.text + "\">") == std::string::npos) continue;
+    named += (named.empty() ? "" : ", ") + Shown(o.text + "." + o.key + "=" + o.value);
+  }
+  return named.empty() ? "" : " (the file as edited by the override(s) " + named + ")";
+}
+
 mjModel* LoadModel(const std::string& path, const std::vector<Override>& overrides,
                    std::string* error) {
   if (overrides.empty()) return LoadModel(path, error);
@@ -351,6 +363,7 @@ mjModel* LoadModel(const std::string& path, const std::vector<Override>& overrid
   if (timestep > 0) m->opt.timestep = timestep;
   if (!Attach(m, path, error)) {
     mj_deleteModel(m);
+    *error += OverridesNamed(*error, overrides);
     return nullptr;
   }
   return m;

@@ -362,6 +362,46 @@ TEST_F(RenderCli, StillsShorterThanAFrameFallOnEveryFrame) {
   }
 }
 
+// --set renders the scene that `run --set` runs: a still with the tether shortened from 20 to
+// 12 m on the command line is, byte for byte, the still of the file edited by hand, and not the
+// still of the file as it is (the shorter tether hangs another way from t = 0). A bad override
+// is refused before anything is rendered (exit 2, naming the key).
+TEST_F(RenderCli, SetOverridesRenderTheSceneEditedByHand) {
+  std::ifstream in(model_);
+  std::string xml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string from = "length=20 segments=40";
+  ASSERT_NE(xml.find(from), std::string::npos) << "models/rov_tether.xml changed: fix the test";
+  xml.replace(xml.find(from), from.size(), "length=12 segments=40");
+  const std::string edited = (dir_ / "edited.xml").string();
+  std::ofstream(edited) << xml;
+  auto still = [&](const std::string& model, const std::string& extra, const std::string& dir) {
+    int status = 0;
+    const std::string out = Shell(cli_ + " render " + model + extra +
+                                      " --duration 0.1 --fps 10 --size 64x48 --samples 0" +
+                                      " --png-every 0.1 " + (dir_ / dir).string() + " 2>&1",
+                                  &status);
+    EXPECT_EQ(status, 0) << out;
+    std::ifstream f(dir_ / dir / "t_00000.100.png", std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  };
+  const std::string set = still(model_, " --set tether:umbilical.length=12", "set");
+  const std::string hand = still(edited, "", "hand");
+  const std::string as_is = still(model_, "", "as_is");
+  ASSERT_FALSE(set.empty());
+  EXPECT_TRUE(set == hand) << "the --set still differs from the hand-edited file's";
+  EXPECT_FALSE(set == as_is) << "the override changed nothing in the picture";
+
+  int status = 0;
+  const std::string bad = Shell(cli_ + " render " + model_ +
+                                    " --duration 0.1 --size 64x48 --samples 0 --png-every 0.1 " +
+                                    (dir_ / "bad").string() +
+                                    " --set tether:umbilical.lenght=12 2>&1",
+                                &status);
+  EXPECT_EQ(status, 2) << bad;
+  EXPECT_NE(bad.find("lenght"), std::string::npos) << bad;
+  EXPECT_FALSE(fs::exists(dir_ / "bad" / "t_00000.000.png")) << bad;
+}
+
 TEST_F(RenderCli, FfmpegFailureIsExitCode4AndBadSizeIs2) {
   int status = 0;
   const std::string out = Shell(cli_ + " render " + model_ +

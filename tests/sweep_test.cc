@@ -130,8 +130,9 @@ TEST(Overrides, RewriteOnlyTheNamedText) {
   EXPECT_TRUE(Contains(error, "no <text name=\"tether:x\">")) << error;
 }
 
-// An out-of-range override gets exactly the message the same value written in the file gets:
-// the same parser and range checks.
+// An out-of-range override gets the message the same value written in the file gets (the same
+// parser and range checks), followed by the override that put it there, since the file on disk
+// does not hold it.
 TEST(Overrides, SameRangeCheckAsTheFile) {
   const std::string dir = TempFolder("range");
   const std::string hand = dir + "/rov_tether.xml";
@@ -140,7 +141,8 @@ TEST(Overrides, SameRangeCheckAsTheFile) {
   EXPECT_EQ(LoadModel(hand, &from_file), nullptr);
   EXPECT_EQ(LoadModel(kScene, {{"tether:umbilical", "EA", "-3"}}, &from_override), nullptr);
   ASSERT_TRUE(Contains(from_file, "'EA'")) << from_file;
-  EXPECT_EQ(from_file.substr(from_file.find(": <text")),
+  EXPECT_EQ(from_file.substr(from_file.find(": <text")) +
+                " (the file as edited by the override(s) tether:umbilical.EA=-3)",
             from_override.substr(from_override.find(": <text")));
 }
 
