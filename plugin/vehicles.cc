@@ -43,6 +43,7 @@ enum VehicleSlot : int {
   kGrowth,      // [-] product of h lambda - 1 over the steps since h lambda last was <= limit
   kGrowthTime,  // [s] d->time of the step last multiplied into kGrowth
   kGrowthSteps, // [-] the steps in that product
+  kCallTime,    // [s] d->time of the latest call (MuJoCo's RK4: which call is a state)
   kVehicleBlock,
 };
 
@@ -267,20 +268,29 @@ void ApplyVehicles(const mjModel* m, mjData* d) {
     }
     Wrench tau = veh.Damping(nu_r);
     if (veh.has_added_mass()) {
-      // The world acceleration over the last step, from the velocities at the last two
-      // callback times (with Euler and implicit: the previous step's qacc). A second call at
-      // the same time reuses it, so repeated mj_forward calls change nothing.
+      // The world acceleration over the last step, from the velocities of the last two states
+      // (with Euler and implicit: the previous step's qacc). A second call at the same time
+      // reuses it, so repeated mj_forward calls change nothing. With MuJoCo's RK4 the callback
+      // also sees the stages' predicted states (t + h/2 twice, then t + h) before the state at
+      // t + h: only a second call at a time a step after the last state's is a state. A
+      // difference over the stages instead fed the remainder's own lagged force back through
+      // RK4's extrapolation, and a vehicle with a remainder of half its mass sank at 70 m/s
+      // (tests/vehicle_test.cc, RK4 case).
+      const bool state =
+          m->opt.integrator != mjINT_RK4 ||
+          (d->time >= u[kTime] + 0.99 * m->opt.timestep && u[kCallTime] == d->time);
       if (u[kSet] == 0 || d->time < u[kTime]) {
         u[kSet] = 1;
         u[kTime] = d->time;
         for (int i = 0; i < 3; ++i) u[kVel + i] = v[i], u[kAcc + i] = 0;
-      } else if (d->time > u[kTime]) {
+      } else if (d->time > u[kTime] && state) {
         for (int i = 0; i < 3; ++i) {
           u[kAcc + i] = (v[i] - u[kVel + i]) / (d->time - u[kTime]);
           u[kVel + i] = v[i];
         }
         u[kTime] = d->time;
       }
+      u[kCallTime] = d->time;
       const Vec3 a(u + kAcc);
       // Body-frame derivative of v_r (the lagged term).
       const Vec3 dv_r = R.transpose() * a - w.cross(nu_r.head<3>());
