@@ -16,3 +16,14 @@ target_compile_definitions(observe_test PRIVATE
   MJTETHER_CLI="$<TARGET_FILE:mjtether>")
 add_dependencies(observe_test mjtether)
 gtest_discover_tests(observe_test NO_PRETTY_VALUES DISCOVERY_TIMEOUT 60)
+
+# The hostile-input generator (tests/hostile_gen_test.cc): the shipped models with random
+# user mistakes, through the real binary; 300 scenes in CI, more on request.
+add_executable(hostile_gen_test hostile_gen_test.cc)
+target_link_libraries(hostile_gen_test PRIVATE mjtether_core GTest::gtest_main Threads::Threads)
+target_compile_definitions(hostile_gen_test PRIVATE
+  MJTETHER_MODELS_DIR="${PROJECT_SOURCE_DIR}/models"
+  MJTETHER_CLI="$<TARGET_FILE:mjtether>")
+add_dependencies(hostile_gen_test mjtether)
+gtest_discover_tests(hostile_gen_test NO_PRETTY_VALUES DISCOVERY_TIMEOUT 60
+  PROPERTIES LABELS hostile TIMEOUT 1200)

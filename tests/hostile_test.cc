@@ -6,25 +6,22 @@
 //
 // With MJTETHER_HOSTILE_VALGRIND=1 only the cases tagged `leak` run, each under valgrind
 // (.ci/run): a definite leak or a memory error fails the case.
-#include <dirent.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
-#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
+#include "run_binary.h"
 #include "text_check.h"
 
 namespace {
@@ -92,12 +89,7 @@ std::string Expand(const std::string& s) {
   return out;
 }
 
-std::string ReadAll(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
+using mjtether::test_util::ReadFileBytes;
 
 // Writes the edited models: 'SRC[>DST]: OLD => NEW ;; OLD => NEW', several groups allowed
 // ('SRC ;; SRC2>DST2: ...' copies SRC to m.xml first).
@@ -118,7 +110,7 @@ void ApplyModel(const std::string& spec, const std::string& dir) {
       const size_t gt = head.find('>');
       const std::string src = Trim(head.substr(0, gt));
       current_dst = gt == std::string::npos ? "m.xml" : Trim(head.substr(gt + 1));
-      text = ReadAll(dir + "/" + src);
+      text = ReadFileBytes(dir + "/" + src);
       if (colon == std::string::npos) continue;
       const std::string edit = part.substr(colon + 2);
       const size_t a = edit.find("=>");
@@ -142,7 +134,7 @@ void ApplyModel(const std::string& spec, const std::string& dir) {
 
 // A CSV whose every row ends with a newline and has the header's number of fields.
 void ExpectCompleteRows(const std::string& path) {
-  const std::string text = ReadAll(path);
+  const std::string text = ReadFileBytes(path);
   ASSERT_FALSE(text.empty()) << path << " is empty or missing";
   EXPECT_EQ(text.back(), '\n') << path << ": the last row is cut";
   std::istringstream s(text);
@@ -186,61 +178,31 @@ TEST_P(Hostile, ExitCodeMessageAndChecks) {
   for (const std::string& check : checks) {
     if (check.rfind("unchanged:", 0) == 0) {
       const std::string file = check.substr(10);
-      before[file] = ReadAll(dir + "/" + file);
+      before[file] = ReadFileBytes(dir + "/" + file);
       ASSERT_FALSE(before[file].empty()) << file;
     }
   }
 
   // Run the binary (under valgrind when asked), with a timeout: a hang fails the case.
-  const std::string out = dir + "/.output";
-  std::string command =
-      std::string("exec ") +
-      (valgrind ? "valgrind -q --leak-check=full --errors-for-leak-kinds=definite "
-                  "--error-exitcode=99 "
-                : "") +
+  const std::string command =
+      std::string(valgrind ? "valgrind -q --leak-check=full --errors-for-leak-kinds=definite "
+                             "--error-exitcode=99 "
+                           : "") +
       MJTETHER_CLI + " " + Expand(c.command);
-  const pid_t pid = fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    if (chdir(dir.c_str()) != 0) _exit(126);
-    freopen("/dev/null", "r", stdin);
-    freopen(out.c_str(), "w", stdout);
-    dup2(fileno(stdout), 2);
-    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
-    _exit(127);
-  }
-  const auto start = std::chrono::steady_clock::now();
   const double timeout = valgrind ? 300 : 120;  // [s]
-  double signal_at = -1;
   int signal = 0;
+  double signal_at = -1;
   if (c.signal != "-") {
     signal = c.signal.rfind("INT@", 0) == 0 ? SIGINT : SIGTERM;
     signal_at = std::stod(c.signal.substr(c.signal.find('@') + 1));
   }
-  int status = 0;
-  bool hung = false;
-  while (true) {
-    const pid_t r = waitpid(pid, &status, WNOHANG);
-    if (r == pid) break;
-    const double t =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (signal && t >= signal_at) {
-      kill(pid, signal);
-      signal = 0;
-    }
-    if (t > timeout) {
-      kill(pid, SIGKILL);
-      waitpid(pid, &status, 0);
-      hung = true;
-      break;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  const std::string output = ReadAll(out);
-  ASSERT_FALSE(hung) << "no exit within " << timeout << " s: " << output.substr(0, 2000);
-  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status) << ": "
-                                 << output.substr(0, 2000);
-  const int code = WEXITSTATUS(status);
+  const mjtether::test_util::BinaryRun run =
+      mjtether::test_util::RunBinary(dir, command, timeout, signal, signal_at);
+  ASSERT_TRUE(run.started) << "fork failed";
+  const std::string& output = run.output;
+  ASSERT_FALSE(run.hung) << "no exit within " << timeout << " s: " << output.substr(0, 2000);
+  ASSERT_TRUE(run.exited) << "killed by signal " << run.signal << ": " << output.substr(0, 2000);
+  const int code = run.code;
   ASSERT_NE(code, 99) << "valgrind found a leak or a memory error:\n" << output.substr(0, 4000);
   EXPECT_EQ(code, c.exit) << output.substr(0, 2000);
   EXPECT_NE(output.find(c.fragment), std::string::npos) << "expected '" << c.fragment << "' in:\n"
@@ -250,7 +212,7 @@ TEST_P(Hostile, ExitCodeMessageAndChecks) {
     if (check == "-" || check == "leak") continue;
     if (check.rfind("unchanged:", 0) == 0) {
       const std::string file = check.substr(10);
-      EXPECT_EQ(ReadAll(dir + "/" + file), before[file]) << file << " was changed";
+      EXPECT_EQ(ReadFileBytes(dir + "/" + file), before[file]) << file << " was changed";
     } else if (check.rfind("absent:", 0) == 0) {
       EXPECT_FALSE(fs::exists(dir + "/" + check.substr(7))) << check;
     } else if (check.rfind("rows:", 0) == 0) {
