@@ -1255,6 +1255,46 @@ bool CheckStart(const mjModel* m, const mjData* d, const Environment& env,
 // disagreed with their 0.2 ms selves, with no word at load (docs/scene_fuzzer.md, session 16).
 constexpr double kContactStartDepth = 1e-3;  // [-] of the diameter
 
+// An end site far outside the body that the tether pulls: farther from the centre of mass of
+// its free body (the subtree's) than kSiteLeverFactor times the reach of that body's geoms plus
+// kSiteLeverMargin. The tether then acts on that lever arm, and the body's effective mass at
+// the site, which the coupling sees, falls with its square: the hostile-input generator's
+// site moved 38 m off a 0.16 kg m^2 vehicle stopped at the first step, told to reduce the step
+// below 1e-4 s. A pos in centimetres where metres were meant does this. A warning, since a long
+// boom without geoms is legitimate. Needs d's kinematics and subtree centres of mass.
+constexpr double kSiteLeverFactor = 3;    // [-]
+constexpr double kSiteLeverMargin = 1;    // [m]
+std::string SiteLeverWarning(const mjModel* m, const mjData* d, const AttachedTether& at) {
+  std::ostringstream s;
+  for (int end = 0; end < 2; ++end) {
+    if (at.site[end] < 0 || !at.coupled[end]) continue;
+    const int carrier = FreeCarrier(m, at.body[end]);
+    if (carrier <= 0) continue;
+    const Vec3 com(d->subtree_com + 3 * carrier);
+    const double lever = (Vec3(d->site_xpos + 3 * at.site[end]) - com).norm();
+    double reach = 0;  // [m] farthest point of the subtree's geoms from its centre of mass
+    bool geoms = false;
+    for (int g = 0; g < m->ngeom; ++g) {
+      int b = m->geom_bodyid[g];
+      while (b > 0 && b != carrier) b = m->body_parentid[b];
+      if (b != carrier) continue;
+      geoms = true;
+      reach = std::max(reach, (Vec3(d->geom_xpos + 3 * g) - com).norm() + m->geom_rbound[g]);
+    }
+    if (!geoms || lever <= kSiteLeverFactor * reach + kSiteLeverMargin) continue;
+    const char* site = mj_id2name(m, mjOBJ_SITE, at.site[end]);
+    const char* body = mj_id2name(m, mjOBJ_BODY, carrier);
+    s << "end " << "AB"[end] << " (site '" << (site ? site : "?") << "') is " << lever
+      << " m from the centre of mass of body '" << (body ? body : "?")
+      << "', whose geoms reach " << reach
+      << " m from it: the tether pulls on that lever arm, and the body's effective mass at the "
+         "site falls with its square (mjtether info prints it as m_eff); check the site's pos "
+         "(metres, not centimetres?)";
+    return s.str();
+  }
+  return "";
+}
+
 std::string ContactStartWarning(const mjModel* m, const mjData* d, const Environment& env,
                                 const AttachedTether& at) {
   if (!at.contact || at.contacts.geoms.empty()) return "";
@@ -2001,6 +2041,7 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
     mjData* scratch = mj_makeData(m);
     if (!scratch) return fail("", "cannot allocate mjData for the start-up checks");
     mj_kinematics(m, scratch);
+    mj_comPos(m, scratch);  // subtree centres of mass (SiteLeverWarning)
     std::string message, element;
     bool ok = true;
     for (AttachedTether& at : set->tethers) {
@@ -2024,6 +2065,9 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
       }
       if (std::string inside = ContactStartWarning(m, scratch, env, at); !inside.empty()) {
         set->warnings.push_back(source + ": <text name=\"tether:" + at.name + "\">: " + inside);
+      }
+      if (std::string lever = SiteLeverWarning(m, scratch, at); !lever.empty()) {
+        set->warnings.push_back(source + ": <text name=\"tether:" + at.name + "\">: " + lever);
       }
     }
     if (ok) ok = CheckVehicles(m, scratch, env, &element, &message);

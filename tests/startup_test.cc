@@ -226,6 +226,52 @@ TEST(StartUpWarning, StretchedStartIsWarnedWithStrainAndTension) {
   EXPECT_TRUE(Contains(out, "a strain of 0.02 and a tension EA x strain = 2000 N")) << out;
 }
 
+// An attachment site far off its body (a pos in centimetres: "-23 0 10" for "-0.23 0 0.1") is
+// warned at load with the lever arm and the body's reach; no shipped model is. The site is then
+// sqrt(23^2 + 10^2) = 25.08 m from the box's centre, whose bounding sphere is
+// sqrt(0.23^2 + 0.17^2 + 0.13^2) = 0.314 m; the limit is 3 x 0.314 + 1 = 1.94 m. (The
+// hostile-input generator's site moved 38 m off a vehicle stopped at the first step, told only to
+// reduce the step below 1e-4 s.)
+class StartUpLever : public MuJoCoFixture {};
+
+std::string ReadModel(const std::string& name) {
+  std::ifstream f(std::string(MJTETHER_MODELS_DIR) + "/" + name);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+bool AnyWarningHas(const mjModel* m, const std::string& text, std::string* all) {
+  bool found = false;
+  for (const std::string& w : Warnings(m)) {
+    *all += w + "\n";
+    found = found || Contains(w, text);
+  }
+  return found;
+}
+
+TEST_F(StartUpLever, ASiteInCentimetresIsWarnedAndNoShippedModelIs) {
+  std::string xml = ReadModel("minimal_rov.xml");
+  const std::string from = R"(<site name="rov_attach" pos="-0.23 0 0.1"/>)";
+  ASSERT_NE(xml.find(from), std::string::npos) << "models/minimal_rov.xml changed: fix the test";
+  xml.replace(xml.find(from), from.size(), R"(<site name="rov_attach" pos="-23 0 10"/>)");
+  std::string all;
+  EXPECT_TRUE(AnyWarningHas(Load(xml, "cm.xml"), "end B (site 'rov_attach') is 25.0", &all))
+      << all;
+  EXPECT_TRUE(Contains(all, "of body 'rov', whose geoms reach 0.31")) << all;
+  EXPECT_TRUE(Contains(all, "check the site's pos")) << all;
+  for (const char* name :
+       {"bluerov2_heavy.xml", "bluerov2_heavy_winch.xml", "hfield_rock.xml",
+        "manoeuvre_dive_return.xml", "manoeuvre_station_keeping.xml", "manoeuvre_surge_snap.xml",
+        "manoeuvre_turn_wrap.xml", "minimal_rov.xml", "rov_tether.xml", "seabed_hfield.xml",
+        "workclass_rov_tms.xml", "workclass_rov_tms_winch.xml"}) {
+    std::string shipped;
+    EXPECT_FALSE(AnyWarningHas(Load(ReadModel(name), std::string(MJTETHER_MODELS_DIR) + "/" + name),
+                               "check the site's pos", &shipped))
+        << name << ": " << shipped;
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // A divergence names its likely cause instead of "reduce the time step".
 
