@@ -8,6 +8,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <tuple>
 
 #include "mjtether.h"
 #include "mjtether_vehicles.h"
@@ -20,7 +21,22 @@ inline std::optional<std::string> StepAndCheck(const mjModel* m, mjData* d,
                                                const std::string& model) {
   const double t0 = d->time;
   const int bad_before = d->warning[mjWARN_BADQACC].number;
+  const int bad_pos = d->warning[mjWARN_BADQPOS].number, bad_vel = d->warning[mjWARN_BADQVEL].number;
   mjtether::Step(m, d);  // Prescribe (schedules at d->time), then mj_step
+  // A state that was not finite (or beyond 1e10) when the step began, set so by the caller (the
+  // schedules and the tethers never write qpos or qvel): MuJoCo resets the data and steps on
+  // from t = 0, which would read as a run that went on.
+  for (const auto& [warning, before, what] :
+       {std::tuple{mjWARN_BADQPOS, bad_pos, "position"}, {mjWARN_BADQVEL, bad_vel, "velocity"}}) {
+    if (d->warning[warning].number > before) {
+      std::ostringstream s;
+      s << model << ": the state at t = " << t0 << " s had a " << what
+        << " that is not a number or beyond MuJoCo's limit 1e10 (index "
+        << d->warning[warning].lastinfo << " of " << (warning == mjWARN_BADQPOS ? "qpos" : "qvel")
+        << "), and MuJoCo reset the simulation; set finite values";
+      return s.str();
+    }
+  }
   if (std::optional<std::string> diverged = mjtether::CheckDivergence(m, d)) return diverged;
   if (d->warning[mjWARN_BADQACC].number > bad_before) {
     std::ostringstream s;

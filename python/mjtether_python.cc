@@ -98,6 +98,7 @@ class Simulation {
   }
 
   static std::unique_ptr<Simulation> FromXml(const std::string& xml, const std::string& name) {
+    if (xml.empty()) throw Error(name + ": the XML text is empty");
     std::string error;
     mjModel* m = mjtether::LoadModelFromString(xml, name, &error);
     return Load(m, name, error);
@@ -442,7 +443,15 @@ PYBIND11_MODULE(mjtether, mod) {
       .def_property_readonly("timestep", [](Simulation& s) { return s.m()->opt.timestep; })
       .def_property(
           "time", [](Simulation& s) { return s.d()->time; },
-          [](Simulation& s, double t) { s.d()->time = t; }, "simulation time [s]")
+          [](Simulation& s, double t) {
+            // A time that is not finite stops the tethers silently (they advance when it does).
+            if (!std::isfinite(t)) {
+              throw py::value_error(s.source() + ": time must be a finite number [s], got " +
+                                    py::str(py::float_(t)).cast<std::string>());
+            }
+            s.d()->time = t;
+          },
+          "simulation time [s]")
       .def_property_readonly(
           "qpos",
           [](py::object self) {

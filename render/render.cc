@@ -10,7 +10,9 @@
 #include <cstdio>
 #include <cstring>
 #include <mutex>
+#include <sstream>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "mjtether.h"
@@ -410,6 +412,16 @@ std::unique_ptr<Renderer> Renderer::CreateIn(mjModel* m, const RenderOptions& op
   if (o.samples < 0 || o.samples > 16) {
     *error = "samples " + std::to_string(o.samples) + " out of range [0, 16]";
     return nullptr;
+  }
+  // The command line checks these as it parses them; a library caller (Python) must be told too.
+  for (const auto& [name, value] : {std::pair{"tension_max", o.tension_max},
+                                    std::pair{"distance", o.distance}}) {
+    if (!std::isfinite(value) || value > 1e12) {
+      std::ostringstream s;
+      s << name << " = " << value << " is not a finite number up to 1e12 (0 or less: automatic)";
+      *error = s.str();
+      return nullptr;
+    }
   }
   std::unique_ptr<Renderer> r(new Renderer());
   r->opt_ = o;

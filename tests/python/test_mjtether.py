@@ -268,3 +268,28 @@ def test_divergence_raises_the_cli_message(tmp_path):
 def test_bad_step_count_is_refused():
     with pytest.raises(ValueError):
         mjtether.Simulation(ROV).step(-1)
+
+
+# Hostile calls found by hand in session 21 (docs/python.md): each was silent before.
+def test_a_state_that_is_not_finite_stops_the_step_instead_of_a_silent_reset():
+    # MuJoCo resets the data on a NaN (or |x| > 1e10) qpos or qvel and steps on from t = 0: step
+    # returned as if the run had gone on (time 0.01 s after 5 steps from 0.02 s).
+    for field, index in (("qpos", 0), ("qvel", 2)):
+        sim = mjtether.Simulation(ROV)
+        sim.step(10)
+        getattr(sim, field)[index] = np.nan if field == "qpos" else 1e30
+        with pytest.raises(mjtether.DivergenceError) as e:
+            sim.step(5)
+        assert "MuJoCo reset the simulation" in str(e.value)
+        assert ("index %d of %s" % (index, field)) in str(e.value)
+
+
+def test_time_and_render_scale_must_be_finite():
+    sim = mjtether.Simulation(ROV)
+    with pytest.raises(ValueError, match="time must be a finite number"):
+        sim.time = float("nan")  # the tethers, which advance with the time, stood still
+    assert sim.time == 0.0
+    with pytest.raises(mjtether.Error, match="tension_max = nan"):
+        sim.render(64, 48, tension_max=float("nan"))  # rendered with an undefined scale
+    with pytest.raises(mjtether.Error, match="the XML text is empty"):
+        mjtether.Simulation.from_xml("")  # was MuJoCo's "mj_makeEmptyFileVFS expects ..."
