@@ -196,13 +196,17 @@ TEST(FramePipelineCli, StillsOfTheSerialAndParallelRunsAreTheSameFiles) {
   const std::string common = cli + " render " + model +
                              " --duration 0.8 --fps 10 --size 320x240 --samples 4 "
                              "--tension-max 1000 --png-every 0.1 ";
-  // What each run printed is kept and shown on failure: under the sanitizers in CI (session 21)
-  // the serial run once exited with 1 and its message was lost to /dev/null.
+  // What each run printed is kept and shown on failure. Under the sanitizers (session 21's CI)
+  // the serial run rendered its 9 stills and then exited with 1: LeakSanitizer's own tracer
+  // crashed at exit ("Tracer caught signal 11 ... LeakSanitizer has encountered a fatal
+  // error"), among llvmpipe's threads. This test is about the pictures, so its runs go without
+  // leak checking (ASAN_OPTIONS is ignored by a build without the sanitizers); the command
+  // line's leaks are checked by valgrind over the hostile inputs and by the other CLI tests.
   for (const char* run : {"serial", "parallel"}) {
     const fs::path log = dir.string() + "_" + run + ".log";
-    const int status =
-        RunShell(common + (dir / run).string() + " --render-threads " +
-                 (std::string(run) == "serial" ? "1" : "3") + " > " + log.string() + " 2>&1");
+    const std::string threads = std::string(run) == "serial" ? "1" : "3";
+    const int status = RunShell("ASAN_OPTIONS=detect_leaks=0 " + common + (dir / run).string() +
+                                " --render-threads " + threads + " > " + log.string() + " 2>&1");
     ASSERT_EQ(status, 0) << run << " run printed:\n" << Slurp(log);
     fs::remove(log);
   }
