@@ -300,21 +300,26 @@ class Mutator {
     Replace(s, out.str());
     return "attribute '" + was + "' -> '" + out.str() + "'";
   }
-  std::string SiteMove() {
-    static const std::regex site(R"re(<site\s[^>]*?pos="([^"]*)")re");
-    const std::vector<Span> all = FindAll(text_, site, 1);
+  // The pos="x y z" of an element matching `element` (group 1) moved by up to `reach` [m] on
+  // each axis.
+  std::string MovePos(const std::regex& element, double reach, const std::string& label) {
+    const std::vector<Span> all = FindAll(text_, element, 1);
     if (all.empty()) return "";
     const Span s = PickOf(all);
     std::istringstream in(Show(s));
     double p[3] = {0, 0, 0};
     in >> p[0] >> p[1] >> p[2];
-    std::uniform_real_distribution<double> offset(-60, 60);
+    std::uniform_real_distribution<double> offset(-reach, reach);
     std::ostringstream out;
     out.precision(6);
     out << p[0] + offset(rng_) << " " << p[1] + offset(rng_) << " " << p[2] + offset(rng_);
     const std::string was = Show(s);
     Replace(s, out.str());
-    return "site pos '" + was + "' -> '" + out.str() + "'";
+    return label + " pos '" + was + "' -> '" + out.str() + "'";
+  }
+  std::string SiteMove() {
+    static const std::regex site(R"re(<site\s[^>]*?pos="([^"]*)")re");
+    return MovePos(site, 60, "site");
   }
   std::string SiteRename() {
     static const std::regex site(R"re(<site\s+name="([^"]*)")re");
@@ -394,19 +399,7 @@ class Mutator {
   }
   std::string BodyMove() {
     static const std::regex body(R"re(<body\s[^>]*?pos="([^"]*)")re");
-    const std::vector<Span> all = FindAll(text_, body, 1);
-    if (all.empty()) return "";
-    const Span s = PickOf(all);
-    std::istringstream in(Show(s));
-    double p[3] = {0, 0, 0};
-    in >> p[0] >> p[1] >> p[2];
-    std::uniform_real_distribution<double> offset(-300, 300);
-    std::ostringstream out;
-    out.precision(6);
-    out << p[0] + offset(rng_) << " " << p[1] + offset(rng_) << " " << p[2] + offset(rng_);
-    const std::string was = Show(s);
-    Replace(s, out.str());
-    return "body pos '" + was + "' -> '" + out.str() + "'";
+    return MovePos(body, 300, "body");
   }
   std::string KeyAdd() {
     static const std::regex data(R"re(<text\s+name="(tether|water|vehicle|thrust|motion|winch)[^"]*"[^>]*?data=")re");
@@ -435,6 +428,16 @@ struct Outcome {
   std::string what;  // the outcome, or why it fails
 };
 
+// The log's NAME.x columns (each body's x; its y and z follow), as `mjtether run` writes them.
+std::vector<size_t> XColumns(const std::vector<std::string>& head) {
+  std::vector<size_t> x;
+  for (size_t c = 0; c + 2 < head.size(); ++c) {
+    const std::string& h = head[c];
+    if (h.size() > 2 && h.compare(h.size() - 2, 2, ".x") == 0) x.push_back(c);
+  }
+  return x;
+}
+
 constexpr double kMaxSpeed = 340;  // [m/s] no ROV scene moves a body faster: a runaway
 
 // Bodies (the log's NAME.x, .y, .z columns) that move faster than kMaxSpeed between samples.
@@ -443,11 +446,7 @@ std::string CheckSpeeds(const std::string& text) {
   std::string line;
   std::getline(s, line);
   const std::vector<std::string> head = mjtether::SplitCsvLine(line);
-  std::vector<size_t> x;
-  for (size_t c = 0; c + 2 < head.size(); ++c) {
-    const std::string& h = head[c];
-    if (h.size() > 2 && h.compare(h.size() - 2, 2, ".x") == 0) x.push_back(c);
-  }
+  const std::vector<size_t> x = XColumns(head);
   std::vector<double> last;
   double t_last = 0;
   while (std::getline(s, line)) {
@@ -695,13 +694,8 @@ std::vector<double> LastPositions(const std::string& path) {
   while (std::getline(s, line)) last = line;
   const std::vector<std::string> f = mjtether::SplitCsvLine(last);
   std::vector<double> out;
-  for (size_t c = 0; c < head.size() && c < f.size(); ++c) {
-    const std::string& h = head[c];
-    if (h.size() > 2 && (h.compare(h.size() - 2, 2, ".x") == 0 ||
-                         h.compare(h.size() - 2, 2, ".y") == 0 ||
-                         h.compare(h.size() - 2, 2, ".z") == 0)) {
-      out.push_back(std::atof(f[c].c_str()));
-    }
+  for (size_t c : XColumns(head)) {
+    for (size_t k = c; k < c + 3 && k < f.size(); ++k) out.push_back(std::atof(f[k].c_str()));
   }
   return out;
 }
