@@ -41,6 +41,8 @@ enum Exit : int {
   kExitMuJoCo = 3,
   kExitTool = 4,
   kExitOutput = 5,  // a write or close of an output failed
+  kExitCheck = 6,   // run --check-step: the run disagrees with the scene at the smaller step,
+                    // or that run stopped where this one did not (cli_step_check.h)
   // 128 + signal number after SIGINT (130) or SIGTERM (143)
 };
 
@@ -158,6 +160,22 @@ inline ModelPtr LoadChecked(const std::string& path,
     std::cerr << "mjtether: warning: " << w << "\n";
   }
   return m;
+}
+
+// A count on the command line: decimal digits only, in [lo, hi] ("2.5", "1e3" and "-1" are
+// named as what they are, not "out of range").
+inline CLI::Validator Count(long long lo, long long hi) {
+  const std::string range = "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  return CLI::Validator(
+      [=](std::string& text) -> std::string {
+        const bool digits =
+            !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+        if (!digits) return "'" + Shown(text) + "' is not a whole number; allowed: " + range;
+        const long long x = text.size() <= 18 ? std::stoll(text) : hi + 1;  // no overflow
+        if (x < lo || x > hi) return "'" + Shown(text) + "' is out of range; allowed: " + range;
+        return "";
+      },
+      range, "INT");
 }
 
 // ---------------------------------------------------------------------------------------------
