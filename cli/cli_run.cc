@@ -3,6 +3,7 @@
 //   mjtether run MODEL.xml --duration S [--log FILE.csv] [--nodes FILE.csv] [--every S]
 //   mjtether info MODEL.xml [--set TEXT.KEY=VALUE]...
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -10,11 +11,13 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "cli_command.h"
 #include "cli_common.h"
 #include "cli_run_summary.h"
+#include "cli_step_check.h"
 #include "step_check.h"
 #include "declaration.h"
 #include "mjtether.h"
@@ -31,6 +34,8 @@ struct RunOptions {
   std::vector<std::string> set;  // TEXT.KEY=VALUE overrides (overrides.h)
   std::string summary;           // one-row CSV about the whole run (cli_run_summary.h)
   int digits = 9;  // significant digits of the CSV numbers (17 round-trips a double)
+  int check_step = 0;  // F: also run at h/F and compare (cli_step_check.h); 0: no check
+  double check_from = 0;  // [s] the comparison starts here (a start-up transient before it)
 };
 
 // Bodies with a free joint: the vehicles whose position the log records.
@@ -47,14 +52,89 @@ std::string BodyName(const mjModel* m, int b) {
   return name && *name ? name : "body" + std::to_string(b);
 }
 
+// The step check's verdict (cli_step_check.h), printed; returns the run's exit status: `status`
+// (0 or 1) where the check has nothing to add, kExitCheck where the run at h/F disagrees or
+// stopped where this one ran on.
+int ReportCheck(const RunOptions& opt, const mjModel* m, double end_time,
+                const mjtether::cli::check::Trace& coarse,
+                const mjtether::cli::check::Trace& fine, const std::vector<int>& bodies,
+                int status, double fine_step) {
+  using namespace mjtether::cli;
+  const std::string head = "mjtether: --check-step " + std::to_string(opt.check_step) + ": ";
+  std::ostringstream at;
+  at.precision(6);
+  at << "--set option.timestep=" << fine_step;
+  if (status == kExitDiverged) {
+    // The run stopped: where did the same scene at h/F get to?
+    if (fine.stop) {
+      std::cerr << head << "at h/" << opt.check_step << " the scene stopped too, at t = "
+                << fine.end_time << " s: the cause is not (only) the step\n";
+    } else if (!fine.interrupted) {
+      std::cerr << head << "at h/" << opt.check_step << " the scene ran to t = "
+                << fine.end_time << " s: the step is the cause; run it with " << at.str()
+                << "\n";
+    }
+    return status;
+  }
+  if (fine.stop) {
+    std::cerr << head << "the same scene at h/" << opt.check_step << " stopped at t = "
+              << fine.end_time << " s where this run went on to " << end_time
+              << " s; this run is not confirmed:\n  " << *fine.stop << "\n";
+    return kExitCheck;
+  }
+  std::vector<std::string> body_names, tether_names;
+  for (int b : bodies) body_names.push_back(BodyName(m, b));
+  for (int k = 0; k < mjtether::TetherCount(m); ++k) {
+    tether_names.push_back(mjtether::TetherName(m, k));
+  }
+  const check::Verdict v = check::Compare(coarse, fine, body_names, tether_names);
+  std::cerr << head << "against the same scene at h/" << opt.check_step << " (" << fine_step
+            << " s), over " << coarse.window_end.size() << " window(s)"
+            << (opt.check_from > 0 ? " from t = " : "");
+  if (opt.check_from > 0) std::cerr << opt.check_from << " s";
+  std::cerr << ":\n"
+            << v.report;
+  if (v.agrees) {
+    std::cerr << head << "agrees within every tolerance\n";
+    return status;
+  }
+  std::cerr << head << "DISAGREES: " << v.first_failure
+            << ". This run's result depends on its step (its outputs are kept); use the "
+               "smaller step ("
+            << at.str() << ") where it matters (docs/step_check.md)\n";
+  return kExitCheck;
+}
+
 int Run(const RunOptions& opt) {
   using namespace mjtether::cli;
   using mjtether::CsvField;
   InstallStopHandlers();
   std::vector<mjtether::Override> overrides;
   if (!ParseSets(opt.set, &overrides)) return kExitBadInput;
+  if (opt.check_step > 0 && !(opt.check_from < opt.duration)) {
+    std::cerr << "mjtether: --check-from " << opt.check_from << " s leaves nothing to compare: "
+              << "it must be below --duration " << opt.duration << " s\n";
+    return kExitBadInput;
+  }
   ModelPtr m = LoadChecked(opt.model, overrides);
   if (!m) return kExitBadInput;
+  // --check-step F: the same scene at h/F (the same overrides, then the step), loaded now so
+  // that a refusal comes before any output is opened. Its load warnings are the run's.
+  ModelPtr fine_model;
+  if (opt.check_step > 0) {
+    std::vector<mjtether::Override> fine_overrides = overrides;
+    std::ostringstream step;
+    step.precision(17);
+    step << m->opt.timestep / opt.check_step;
+    fine_overrides.push_back({"option", "timestep", step.str()});
+    std::string error;
+    fine_model.reset(mjtether::LoadModel(opt.model, fine_overrides, &error));
+    if (!fine_model) {
+      std::cerr << "mjtether: --check-step " << opt.check_step << ": at the step "
+                << step.str() << " s the scene cannot be loaded: " << error << "\n";
+      return kExitBadInput;
+    }
+  }
   // Every output is claimed and opened (as a temporary file) before the run: a bad second path
   // leaves the first untouched, and no output may be an input or the other output.
   OutputGuard guard;
@@ -164,6 +244,24 @@ int Run(const RunOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
   int status = kExitOk;
   bool stall_noticed = false;
+  // The step check's fine run, on a second thread (cli_step_check.h).
+  std::optional<check::Recorder> recorder;
+  check::Trace fine_trace;
+  std::atomic<bool> cancel_fine{false};
+  std::thread fine_thread;
+  const long long per_window = check::StepsPerWindow(h, opt.duration - opt.check_from);
+  if (fine_model) {
+    std::cerr << "mjtether: --check-step " << opt.check_step << ": the scene runs also at h/"
+              << opt.check_step << " = " << fine_model->opt.timestep
+              << " s on a second thread, about " << opt.check_step << "x the cost\n";
+    const long long skip = std::min(steps, std::llround(opt.check_from / h));
+    recorder.emplace(mm, bodies, per_window, skip);
+    mjtether::Prescribe(mm, d);
+    recorder->Start(mm, observer.Observe(d));
+    fine_thread = std::thread(check::RunFine, fine_model.get(), steps * opt.check_step,
+                              std::cref(bodies), per_window * opt.check_step,
+                              skip * opt.check_step, std::cref(opt.model), std::cref(cancel_fine), &fine_trace);
+  }
   for (long long i = 0;; ++i) {
     mjtether::Prescribe(mm, d);  // motion: and thrust: declarations at d->time
     if (i == next_sample) {
@@ -188,6 +286,7 @@ int Run(const RunOptions& opt) {
       break;
     }
     if (run_summary) run_summary->Observe(mm, d);
+    if (recorder) recorder->AfterStep(mm, d);
     // Stalled implicit steps make a run slow: said once, as soon as seen (the check costs a
     // look at each tether's counter; the full warning with the count comes at the end).
     if (!stall_noticed) {
@@ -199,6 +298,13 @@ int Run(const RunOptions& opt) {
   }
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (recorder) {
+    recorder->Finish(mm, d);
+    // A signal or a failed write: the fine run stops too (a divergence lets it run on, to say
+    // whether the step was the cause).
+    if (status != kExitOk && status != kExitDiverged) cancel_fine = true;
+    fine_thread.join();
+  }
   // Implicit steps that did not converge: once per run, at its end (README, Numerics).
   for (const std::string& w : mjtether::StallWarnings(mm, d)) {
     std::cerr << "mjtether: warning: " << w << "\n";
@@ -214,6 +320,10 @@ int Run(const RunOptions& opt) {
               << (wall > 0 ? d->time / wall : 0) << "x real time)";
     if (!opt.log.empty()) std::cerr << "; log: " << opt.log;
     std::cerr << "\n";
+  }
+  if (recorder && status <= kExitDiverged) {
+    status = ReportCheck(opt, mm, d->time, recorder->trace(), fine_trace, bodies, status,
+                         fine_model->opt.timestep);
   }
   // The summary observes the final state as the last log row does (brought to d->time on a copy).
   if (run_summary && !run_summary->Write(opt.summary, mm, observer.Observe(d))) {
@@ -322,10 +432,20 @@ std::function<int()> SetupRun(CLI::App* sub) {
       ->check(mjtether::cli::Number(0, 1e7, true, "s"));
   sub->add_option("--digits", opt->digits,
                   "significant digits of the CSV numbers (default 9; 17 is exact)")
-      ->check(CLI::Range(1, 17));
+      ->check(mjtether::cli::Count(1, 17));
   mjtether::cli::AddSetOption(sub, &opt->set);
   sub->add_option("--summary", opt->summary,
                   "CSV row: peak tension over every step, the vehicle's final pose");
+  CLI::Option* check_step = sub->add_option("--check-step", opt->check_step,
+                  "also run the scene at a step F times smaller (on a second thread) and "
+                  "compare: bodies within max(5 cm, 2% of the span), window means and peak "
+                  "tensions within max(0.5 N, 5%); exit 6 where they disagree (10 is usual)")
+      ->check(mjtether::cli::Count(2, mjtether::cli::check::kMaxFactor));
+  sub->add_option("--check-from", opt->check_from,
+                  "with --check-step: compare from this time on, leaving out a start-up "
+                  "transient [s] (default 0)")
+      ->check(mjtether::cli::Number(0, 1e7, false, "s"))
+      ->needs(check_step);
   return [opt]() { return Run(*opt); };
 }
 
