@@ -6,6 +6,7 @@
 // process with another MuJoCo Python package (mjcb_passive is one global pointer per libmujoco).
 #include <dlfcn.h>
 #include <mjtether/mjtether.h>
+#include <mjtether/overrides.h>
 #include <mjtether/render.h>
 #include <mjtether/version.h>
 #include <mujoco/mujoco.h>
@@ -87,12 +88,22 @@ class Simulation {
     return sim;
   }
 
-  static std::unique_ptr<Simulation> FromFile(const std::string& path) {
+  // `set`: overrides as `mjtether run --set` takes them, "TEXT.KEY=VALUE" or
+  // "option.timestep=SECONDS" (overrides.h): e.g. the same scene at a smaller step.
+  static std::unique_ptr<Simulation> FromFile(const std::string& path,
+                                              const std::vector<std::string>& set) {
+    std::vector<mjtether::Override> overrides;
+    for (const std::string& spec : set) {
+      std::string why;
+      std::optional<mjtether::Override> o = mjtether::ParseOverride(spec, &why);
+      if (!o) throw Error(path + ": set: " + why);
+      overrides.push_back(*o);
+    }
     std::string error;
     mjModel* m = nullptr;
     {
       py::gil_scoped_release release;
-      m = mjtether::LoadModel(path, &error);
+      m = mjtether::LoadModel(path, overrides, &error);
     }
     return Load(m, path, error);
   }
@@ -390,7 +401,10 @@ PYBIND11_MODULE(mjtether, mod) {
   py::class_<Simulation>(mod, "Simulation",
                          "An MJCF model with its tethers, vehicles and schedules, and its state.")
       .def(py::init(&Simulation::FromFile), py::arg("path"),
-           "Loads an MJCF file; raises mjtether.Error with the CLI's message on bad input.")
+           py::arg("set") = std::vector<std::string>(),
+           "Loads an MJCF file; raises mjtether.Error with the CLI's message on bad input. "
+           "`set`: overrides as `mjtether run --set` takes them, e.g. "
+           "['tether:umbilical.EA=4e5', 'option.timestep=0.0002'].")
       .def_static("from_xml", &Simulation::FromXml, py::arg("xml"), py::arg("name") = "<string>",
                   "Loads MJCF text; `name` stands for the file.")
       .def(

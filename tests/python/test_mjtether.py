@@ -254,6 +254,45 @@ def test_load_errors_carry_the_cli_message(tmp_path):
         mjtether.Simulation(ROV).tether("no_such_tether")
 
 
+def test_set_overrides_are_the_file_edited_by_hand(tmp_path):
+    # Simulation(path, set=[...]) takes `mjtether run --set`'s overrides: the scene with EA
+    # overridden runs bit for bit as the file edited by hand (loaded from its text under the
+    # same path), and differs from the file as it is (the override is not ignored).
+    with open(ROV) as f:
+        text = f.read()
+    assert text.count("EA=6e4 ") == 1
+    edited = mjtether.Simulation.from_xml(text.replace("EA=6e4 ", "EA=2e4 "), ROV)
+    overridden = mjtether.Simulation(ROV, set=["tether:umbilical.EA=2e4"])
+    plain = mjtether.Simulation(ROV)
+    for sim in (edited, overridden, plain):
+        sim.step(250)
+    assert state(overridden) == state(edited)
+    assert state(overridden) != state(plain)
+    # A refused override carries the CLI's message for the same --set.
+    status, message = cli_error("info", ROV, "--set", "tether:umbilical.EA=-5")
+    assert status == 2
+    with pytest.raises(mjtether.Error) as e:
+        mjtether.Simulation(ROV, set=["tether:umbilical.EA=-5"])
+    assert str(e.value) == message
+    with pytest.raises(mjtether.Error, match="TEXT.KEY=VALUE|KEY=VALUE|="):
+        mjtether.Simulation(ROV, set=["no_equals_sign"])
+
+
+def test_set_timestep_runs_the_same_scene_at_a_smaller_step():
+    # The comparison `mjtether run --check-step 10` makes, from Python: the same scene at h/10,
+    # stepped ten times as often, ends where the run at h ends, within the step check's
+    # tolerance for a body (max(5 cm, 2% of the span); docs/step_check.md).
+    coarse = mjtether.Simulation(ROV)
+    fine = mjtether.Simulation(ROV, set=["option.timestep=%r" % (coarse.timestep / 10)])
+    assert fine.timestep == pytest.approx(coarse.timestep / 10, rel=1e-15)
+    start = coarse.body("rov").pos.copy()
+    coarse.step(1500)  # 3 s: the thrust schedule moves the vehicle 0.23 m
+    fine.step(15000)
+    assert fine.time == pytest.approx(coarse.time, rel=1e-9)
+    assert np.linalg.norm(coarse.body("rov").pos - start) > 0.1  # not two resting bodies
+    assert np.linalg.norm(coarse.body("rov").pos - fine.body("rov").pos) < 0.05
+
+
 def test_divergence_raises_the_cli_message(tmp_path):
     path = tmp_path / "unstable.xml"
     path.write_text(UNSTABLE)
