@@ -312,7 +312,14 @@ void RecordFailure(double* u, const StepStatus& status, double time) {
 // An end teleported by the user (qpos or mocap_pos set by hand): since the last call it moved
 // farther than its velocity then explains, by more than max_strain segment lengths. No tether
 // can follow that within max_strain, so the tether restarts from its initial shape instead of
-// being reported as diverged. (A real end that accelerates at a would need a dt^2/2 > that.)
+// being reported as diverged.
+// A body that MuJoCo moved was not teleported, however hard it accelerated: its step took it
+// along its new velocity (x + h v_new, semi-implicit Euler and implicit; RK4 between the old
+// and the new one), which explains the move. Without that, a vehicle flung by a 4e8 N
+// stretched start (the scene fuzzer's seed 391: 33 m in one step, a dt^2/2 of 12 m) counted
+// as teleported, and the tether restarted silently from a new initial shape. A mocap body's
+// velocity is a finite difference of its positions, which a jump by hand also moves: its ends
+// are judged by the velocity before the move only.
 bool Teleported(const AttachedTether& at, const Ends& now, const double* u, double time) {
   const double dt = time - u[kTime];
   if (u[kInitialized] == 0 || !(dt > 0)) return false;
@@ -320,8 +327,14 @@ bool Teleported(const AttachedTether& at, const Ends& now, const double* u, doub
   for (int end = 0; end < 2; ++end) {
     if (at.site[end] < 0) continue;
     const double* stored = u + (end == 0 ? kEndA : kEndB);
-    const Vec3& pos = end == 0 ? now.a.pos : now.b.pos;
-    if ((pos - Vec3(stored) - dt * Vec3(stored + 3)).norm() > jump) return true;
+    const EndState& e = end == 0 ? now.a : now.b;
+    const Vec3 moved = e.pos - Vec3(stored), v_old(stored + 3);
+    if ((moved - dt * v_old).norm() <= jump) continue;
+    if (!at.mocap[end] && ((moved - dt * e.vel).norm() <= jump ||
+                           (moved - 0.5 * dt * (v_old + e.vel)).norm() <= jump)) {
+      continue;
+    }
+    return true;
   }
   return false;
 }
@@ -1478,9 +1491,11 @@ std::string ThrustCause(const mjModel* m, const mjData* d, const AttachedTether&
 
 // The most likely cause of a divergence, from the state of the scene when it was reported,
 // with what to change; empty if none of the checkable causes applies (the step is then the
-// likely one). In order: thrust beyond what the tether holds, ends pulled apart to a mean
-// strain within the strain spread along the line of max_strain (or beyond it), an end moving more than half of max_strain L0 in one step, an end
-// below the seabed, a divergence within kStartSteps steps of a stretched start.
+// likely one). In order: thrust beyond what the tether holds; within kStartSteps steps of a
+// start stretched beyond kStretchWarning, the start (unless the ends were pulled apart mostly
+// by a prescribed motion); ends pulled apart to a mean strain within the strain spread along
+// the line of max_strain (or beyond it); an end moving more than half of max_strain L0 in one
+// step; an end below the seabed; a divergence within kStartSteps steps of a stretched start.
 std::string Diagnose(const mjModel* m, const mjData* d, const Environment& env,
                      const AttachedTether& at, const double* u) {
   constexpr int kStartSteps = 50;
@@ -1528,6 +1543,39 @@ std::string Diagnose(const mjModel* m, const mjData* d, const Environment& env,
     wave_spread = 2 * separating / std::sqrt(p.EA / p.mass_per_length);
     spread = weight_spread + wave_spread;
   }
+  const double h = m->opt.timestep;
+  // A stretched start whose release diverged within kStartSteps steps (the start-up strain,
+  // below, without anything else to blame).
+  const bool start_up =
+      u[kStartStrain] > 0 && u[kBadTime] - u[kStartTime] <= kStartSteps * h * (1 + 1e-9);
+  auto start_up_cause = [&]() {
+    s << "start-up strain: the tether started stretched by " << u[kStartStrain]
+      << " (tension EA x strain = " << p.EA * u[kStartStrain] << " N) and diverged "
+      << u[kBadTime] - u[kStartTime]
+      << " s later; make it at least as long as the distance between its ends ("
+      << p.length * (1 + u[kStartStrain]) << " m)";
+    return s.str();
+  };
+  // Ends found far apart right after a stretched start, but not moved apart by a motion: the
+  // start's release flung a body (the scene fuzzer's seeds 391, 617 and 657: 87% stretched,
+  // the vehicle thrown 25-90 m in two steps, a TMS moving 0.7 m, and the stop blamed on the
+  // TMS's motion or on "forces on body 'rov'"; at 0.2 ms they run). The prescribed motions
+  // must account for at least half of the chord's growth since the start to be the cause.
+  // The same holds for a body thrown faster than the step resolves (below): right after a
+  // stretched start that Attach warned about (kStretchWarning), the start is named first.
+  if (start_up && u[kStartStrain] > kStretchWarning) {
+    const double growth = (pos[1] - pos[0]).norm() - p.length * (1 + u[kStartStrain]);
+    double moved = 0;  // [m] the mocap ends' displacement since the start
+    for (int end = 0; end < 2; ++end) {
+      int b = at.body[end];  // the mocap body that carries the end (MovedByMocap)
+      while (b > 0 && m->body_mocapid[b] < 0) b = m->body_parentid[b];
+      if (!at.mocap[end] || b <= 0) continue;
+      moved += mju_dist3(d->mocap_pos + 3 * m->body_mocapid[b], m->body_pos + 3 * b);
+    }
+    if (!(mean_strain > 0 && mean_strain >= p.max_strain - spread) || moved < 0.5 * growth) {
+      return start_up_cause();
+    }
+  }
   if (both && mean_strain > 0 && mean_strain >= p.max_strain - spread) {
     s << "the ends were pulled " << (pos[1] - pos[0]).norm() << " m apart, a mean strain of "
       << mean_strain << " against max_strain = " << p.max_strain;
@@ -1556,7 +1604,6 @@ std::string Diagnose(const mjModel* m, const mjData* d, const Environment& env,
     s << ", by the motion of the ends' bodies; lengthen the tether or limit that motion";
     return s.str();
   }
-  const double h = m->opt.timestep;
   for (int end = 0; end < (both ? 2 : 1); ++end) {
     const double travel = vel[end].norm() * h;
     if (travel > 0.5 * p.max_strain * t.rest_segment_length()) {
@@ -1583,14 +1630,7 @@ std::string Diagnose(const mjModel* m, const mjData* d, const Environment& env,
       }
     }
   }
-  if (u[kStartStrain] > 0 && u[kBadTime] - u[kStartTime] <= kStartSteps * h * (1 + 1e-9)) {
-    s << "start-up strain: the tether started stretched by " << u[kStartStrain]
-      << " (tension EA x strain = " << p.EA * u[kStartStrain] << " N) and diverged "
-      << u[kBadTime] - u[kStartTime]
-      << " s later; make it at least as long as the distance between its ends ("
-      << p.length * (1 + u[kStartStrain]) << " m)";
-    return s.str();
-  }
+  if (start_up) return start_up_cause();
   // The thrust: schedules drive an end's body beyond what the tether holds, though the thrust
   // at this instant is below it: a smaller step diverges too, later, so the step is not the
   // cause (the scene fuzzer's long run, session 11: 26 runs blamed the step whose 0.2 ms runs
