@@ -52,12 +52,15 @@ def check(cli, path, check_from):
 
 
 def fuzz_outcomes(path):
+    """seed -> (outcome, detail): "agrees", "diverged", ... and, for a stop, its checked cause."""
     out = {}
     for line in open(path, errors="replace"):
         m = re.match(r"seed (\d+) \[[^\]]*\]: (\w+): (.*)", line)
         if m:
-            out[int(m.group(1))] = ("fails" if m.group(2) != "pass" else
-                                    m.group(3).split(":")[0].split(" with")[0].strip())
+            fields = m.group(3).split(":")
+            outcome = ("fails" if m.group(2) != "pass" else
+                       fields[0].split(" with")[0].strip())
+            out[int(m.group(1))] = (outcome, fields[1].strip() if len(fields) > 1 else "")
     return out
 
 
@@ -85,15 +88,15 @@ def main():
     first_off = collections.Counter()
     stops = collections.Counter()
     for s, (rc, err) in runs.items():
-        outcome = fuzz.get(s, "not in the log")
+        outcome, cause = fuzz.get(s, ("not in the log", ""))
         table[outcome][rc] += 1
         if rc == 6 and outcome == "agrees":
             line = next((l for l in err.splitlines() if "DISAGREES" in l), "")
             first_off["position" if "position" in line else "peak" if "peak" in line
                       else "window mean" if "mean" in line else "other"] += 1
         if rc == 1:
-            stops["cured by h/10" if "the step is the cause" in err else
-                  "stops at h/10 too" if "stopped too" in err else "other"] += 1
+            stops[("cured by h/10" if "the step is the cause" in err else
+                   "stops at h/10 too" if "stopped too" in err else "other", cause)] += 1
     print("| fuzzer outcome | scenes | exit 0 | exit 6 | exit 1 | exit 2 | other |")
     print("|---|---:|---:|---:|---:|---:|---:|")
     for outcome, c in sorted(table.items()):
@@ -101,7 +104,9 @@ def main():
         print("| %s | %d | %d | %d | %d | %d | %d |" % (outcome, sum(c.values()), c[0], c[6],
                                                       c[1], c[2], other))
     print("fuzzer-agreeing scenes flagged, by the first quantity off:", dict(first_off))
-    print("stops:", dict(stops))
+    print("stops, by what the check said and the fuzzer's checked cause:")
+    for (said, cause), n in sorted(stops.items()):
+        print("  %3d  %s: %s" % (n, said, cause))
 
 
 if __name__ == "__main__":
