@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <csignal>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -247,7 +248,8 @@ int Run(const RunOptions& opt) {
   // The step check's fine run, on a second thread (cli_step_check.h).
   std::optional<check::Recorder> recorder;
   check::Trace fine_trace;
-  std::atomic<bool> cancel_fine{false};
+  std::atomic<bool> cancel_fine{false}, fine_done{false};
+  std::atomic<double> fine_progress{0};  // [s] the fine run's time
   std::thread fine_thread;
   const long long per_window = check::StepsPerWindow(h, opt.duration - opt.check_from);
   if (fine_model) {
@@ -260,7 +262,8 @@ int Run(const RunOptions& opt) {
     recorder->Start(mm, observer.Observe(d));
     fine_thread = std::thread(check::RunFine, fine_model.get(), steps * opt.check_step,
                               std::cref(bodies), per_window * opt.check_step,
-                              skip * opt.check_step, std::cref(opt.model), std::cref(cancel_fine), &fine_trace);
+                              skip * opt.check_step, std::cref(opt.model),
+                              std::cref(cancel_fine), &fine_progress, &fine_done, &fine_trace);
   }
   for (long long i = 0;; ++i) {
     mjtether::Prescribe(mm, d);  // motion: and thrust: declarations at d->time
@@ -303,7 +306,6 @@ int Run(const RunOptions& opt) {
     // A signal or a failed write: the fine run stops too (a divergence lets it run on, to say
     // whether the step was the cause).
     if (status != kExitOk && status != kExitDiverged) cancel_fine = true;
-    fine_thread.join();
   }
   // Implicit steps that did not converge: once per run, at its end (README, Numerics).
   for (const std::string& w : mjtether::StallWarnings(mm, d)) {
@@ -321,14 +323,40 @@ int Run(const RunOptions& opt) {
     if (!opt.log.empty()) std::cerr << "; log: " << opt.log;
     std::cerr << "\n";
   }
-  if (recorder && status <= kExitDiverged) {
-    status = ReportCheck(opt, mm, d->time, recorder->trace(), fine_trace, bodies, status,
-                         fine_model->opt.timestep);
-  }
   // The summary observes the final state as the last log row does (brought to d->time on a copy).
   if (run_summary && !run_summary->Write(opt.summary, mm, observer.Observe(d))) {
     std::cerr << "mjtether: output error: cannot write --summary " << opt.summary << "\n";
     status = status ? status : kExitOutput;
+  }
+  if (recorder) {
+    // The run's outputs are complete; the run at h/F may take F times longer: its progress
+    // every 10 s, and a signal stops it.
+    const auto waiting = std::chrono::steady_clock::now();
+    int said = 0, signal = 0;
+    while (!fine_done.load()) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      if (!signal && StopSignal()) signal = StopSignal(), cancel_fine = true;
+      const double waited =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - waiting).count();
+      if (!signal && waited >= 10 * (said + 1)) {
+        ++said;
+        std::cerr << "mjtether: --check-step " << opt.check_step << ": the run at h/"
+                  << opt.check_step << " is at t = " << fine_progress.load() << " of "
+                  << steps * h << " s\n";
+      }
+    }
+    fine_thread.join();
+    if (signal && status <= kExitDiverged) {
+      std::cerr << "mjtether: --check-step " << opt.check_step << ": interrupted by "
+                << (signal == SIGINT ? "SIGINT" : "SIGTERM") << " while the run at h/"
+                << opt.check_step << " was at t = " << fine_progress.load()
+                << " s; nothing was compared (this run's outputs are complete)\n";
+      return 128 + signal;
+    }
+    if (status <= kExitDiverged) {
+      status = ReportCheck(opt, mm, d->time, recorder->trace(), fine_trace, bodies, status,
+                           fine_model->opt.timestep);
+    }
   }
   return status;
 }

@@ -33,6 +33,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_common.h"  // StopSignal
 #include "mjtether.h"
 #include "step_check.h"
 
@@ -144,11 +145,13 @@ class Recorder {
   Trace trace_;
 };
 
-// Runs `steps` steps of m (the fine run, on its own thread) and records them. Stops early on a
-// divergence (StepAndCheck), a signal, or `cancel`.
+// Runs `steps` steps of m (the fine run, on its own thread) and records them; `progress` is its
+// time, `done` set at the end. Stops early on a divergence (StepAndCheck), a signal (SIGINT or
+// SIGTERM, StopSignal), or `cancel`.
 inline void RunFine(const mjModel* m, long long steps, const std::vector<int>& bodies,
                     long long steps_per_window, long long skip, const std::string& model,
-                    const std::atomic<bool>& cancel, Trace* out) {
+                    const std::atomic<bool>& cancel, std::atomic<double>* progress,
+                    std::atomic<bool>* done, Trace* out) {
   mjData* d = mj_makeData(m);
   Recorder rec(m, bodies, steps_per_window, skip);
   Prescribe(m, d);
@@ -159,7 +162,7 @@ inline void RunFine(const mjModel* m, long long steps, const std::vector<int>& b
     mj_deleteData(start);
   }
   for (long long i = 0; i < steps; ++i) {
-    if (cancel.load(std::memory_order_relaxed)) {
+    if (cancel.load(std::memory_order_relaxed) || StopSignal()) {
       rec.trace().interrupted = true;
       break;
     }
@@ -168,10 +171,12 @@ inline void RunFine(const mjModel* m, long long steps, const std::vector<int>& b
       break;
     }
     rec.AfterStep(m, d);
+    progress->store(d->time, std::memory_order_relaxed);
   }
   rec.Finish(m, d);
   *out = std::move(rec.trace());
   mj_deleteData(d);
+  done->store(true);
 }
 
 struct Verdict {
