@@ -119,6 +119,18 @@ int Run(const RunOptions& opt) {
   }
   ModelPtr m = LoadChecked(opt.model, overrides);
   if (!m) return kExitBadInput;
+  // A load warning that says the outcome depends on the step (a stretched start, a thrust near
+  // what the tether holds, a held end force) asks for a comparison that --check-step makes.
+  if (opt.check_step == 0) {
+    for (const std::string& w : mjtether::Warnings(m.get())) {
+      if (w.find("compare with a smaller one") != std::string::npos ||
+          w.find("10x smaller step") != std::string::npos) {
+        std::cerr << "mjtether: note: --check-step 10 makes that comparison: it runs the scene "
+                     "also at h/10 and says whether this run is off (docs/step_check.md)\n";
+        break;
+      }
+    }
+  }
   // --check-step F: the same scene at h/F (the same overrides, then the step), loaded now so
   // that a refusal comes before any output is opened. Its load warnings are the run's.
   ModelPtr fine_model;

@@ -187,6 +187,11 @@ TEST(StepCheck, AStepDependentRunExitsSixAndKeepsItsLog) {
                                        c.rows[k][x + 2] - f.rows[k][x + 2]));
   }
   ASSERT_GT(worst, tol) << "the scene no longer depends on its step: choose another";
+  // The stretched start is warned about at load ("compare with a smaller one"): the plain run
+  // points to the check, the checked run does not.
+  const std::string note = "note: --check-step 10 makes that comparison";
+  EXPECT_NE(coarse.text.find(note), std::string::npos) << coarse.text;
+  EXPECT_EQ(check.text.find(note), std::string::npos) << check.text;
   EXPECT_EQ(check.status, 6) << check.text;
   EXPECT_NE(check.text.find("DISAGREES: body 'rov': position off by"), std::string::npos)
       << check.text;
