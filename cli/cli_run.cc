@@ -341,10 +341,16 @@ int Run(const RunOptions& opt) {
     status = status ? status : kExitOutput;
   }
   if (recorder) {
-    // The run's outputs are complete; the run at h/F may take F times longer: its progress
-    // every 10 s, and a signal stops it.
+    // The run's outputs are complete; the run at h/F may take F times longer: say so at once
+    // (the user sees why the program has not exited), then its progress every 10 s; a signal
+    // stops it.
     const auto waiting = std::chrono::steady_clock::now();
     int said = 0, signal = 0;
+    if (!fine_done.load())
+      std::cerr << "mjtether: --check-step " << opt.check_step << ": this run's outputs are "
+                << "complete; waiting for the run at h/" << opt.check_step << " (Ctrl-C stops "
+                << "it): the run at h/" << opt.check_step << " is at t = "
+                << fine_progress.load() << " of " << steps * h << " s\n";
     while (!fine_done.load()) {
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
       if (!signal && StopSignal()) signal = StopSignal(), cancel_fine = true;
