@@ -428,6 +428,10 @@ int Info(const std::string& path, const std::vector<std::string>& set) {
       if (c.consistent) {
         std::cout << "; consistent coupling (end node B solved with the body in the tether's "
                      "step)";
+        if (c.heavy_node) {
+          std::cout << ", end node B (" << c.m_node
+                    << " kg with its added mass) outweighing m_eff";
+        }
       } else if (c.omega_h > 0) {
         std::cout << "; held end force";
       }

@@ -77,6 +77,11 @@ struct CouplingLimit {
   // [-] h damping/(L0 m_eff): the end segment's internal damping on the body over the step
   // (0 without damping); the consistent coupling is also taken from 0.025 on (docs/coupling.md)
   double damping_h = 0;
+  // End node B (mass and normal added mass) is heavier than m_eff: the held force would lose
+  // an inertia larger than the body's, so implicit and bdf2 take the consistent coupling
+  // whatever omega h (docs/coupling.md, session 23)
+  bool heavy_node = false;
+  double m_node = 0;  // [kg] the end node's mass with its normal added mass
 };
 CouplingLimit GetCouplingLimit(const mjModel* m, int k, int end);
 // How the static start of tether k went at load (start=static; docs/static_start.md): pseudo

@@ -1809,17 +1809,44 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
       // The end segment's internal damping on the body's effective mass over the step.
       c.damping_h = h * t.EndDamping() / c.m_eff;
       const bool has_lead = std::isfinite(lead_from);  // rk4 has no consistent coupling
-      const bool stiff =
-          c.omega_h >= lead_from || (has_lead && c.damping_h >= kLeadFromDamping);
-      if (end == 1 && stiff &&
-          !at.coupled[0] && !at.contact && !p.clamp_b &&
+      // An end node heavier than the body's lightest effective mass: the held force gives the
+      // body the node's forces without its inertia m_B a_B, which then is no small correction,
+      // and the consistent coupling keeps it there (ImplicitStep, EndInertia): at any omega h
+      // the two are then two models, and a run's fine-step self (below lead_from) was the other.
+      c.m_node = t.NodeInertiaMax(end == 0 ? 0 : t.segments());
+      c.heavy_node = c.m_node > c.m_eff;
+      const bool stiff = c.omega_h >= lead_from ||
+                         (has_lead && c.damping_h >= kLeadFromDamping) ||
+                         (has_lead && c.heavy_node);
+      // Where the consistent coupling can be taken, whatever the integrator.
+      const bool lead_possible = end == 1 && !at.coupled[0] && !at.contact && !p.clamp_b &&
+                                 FreeCarrier(m, at.body[1]) > 0 &&
+                                 m->opt.integrator != mjINT_RK4;
+      if (stiff && lead_possible &&
           // On a winch (at end A) explicit only: with implicit and bdf2 the world draw's
           // winch scenes lost accuracy with it (docs/coupling.md, session 16).
-          (!at.winch || (!at.swapped && p.integrator == Integrator::kExplicit)) &&
-          FreeCarrier(m, at.body[1]) > 0 && m->opt.integrator != mjINT_RK4) {
+          (!at.winch || (!at.swapped && p.integrator == Integrator::kExplicit))) {
         at.lead = t.WithDynamicEndB();
         c.consistent = true;
         if (p.integrator == Integrator::kImplicit2) c.limit = 0;
+      }
+      if (c.heavy_node && !c.consistent) {
+        // The held force here (rk4, end A, or a condition of the consistent coupling not met):
+        // the body moves as if the node weighed nothing. A modelling error, not the step's:
+        // named with the segment count that makes the node lighter than the body.
+        const char* name = mj_id2name(m, mjOBJ_BODY, c.body);
+        std::ostringstream w;
+        w << where << "end " << (end == 0 ? "A" : "B") << " on body '" << (name ? name : "?")
+          << "': the end node (" << c.m_node << " kg: half a segment with its normal added "
+          << "mass) is heavier than the body's smallest effective mass " << c.m_eff
+          << " kg, and the body gets the held end force, which leaves the node's inertia out "
+          << "(the body accelerates as if the node weighed nothing); use segments >= "
+          << static_cast<long>(std::ceil(c.m_node * t.segments() / c.m_eff))
+          << (!has_lead && lead_possible && !at.winch
+                  ? " or integrator=bdf2 (the default), implicit, implicit2 or explicit, which "
+                    "carry the node with the body (docs/coupling.md)"
+                  : "");
+        set->warnings.push_back(w.str());
       }
       c.applies = c.limit > 0;
       if (!c.applies) continue;
