@@ -1816,8 +1816,7 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
       c.m_node = t.NodeInertiaMax(end == 0 ? 0 : t.segments());
       c.heavy_node = c.m_node > c.m_eff;
       const bool stiff = c.omega_h >= lead_from ||
-                         (has_lead && c.damping_h >= kLeadFromDamping) ||
-                         (has_lead && c.heavy_node);
+                         (has_lead && (c.damping_h >= kLeadFromDamping || c.heavy_node));
       // Where the consistent coupling can be taken, whatever the integrator.
       const bool lead_possible = end == 1 && !at.coupled[0] && !at.contact && !p.clamp_b &&
                                  FreeCarrier(m, at.body[1]) > 0 &&

@@ -201,6 +201,67 @@ TEST_F(LightVehicle, HeavilyDampedEndTakesTheConsistentCouplingAndAgreesWithItsF
   }
 }
 
+// The momentum balance of a free body at end B of a tether anchored at end A (no gravity, no
+// water): the body starts at (10.001, 0, 0) moving 0.1 m/s away from the anchor; after a first
+// step (which sets the initial shape and, with bdf2, its history), 250 more steps. Nothing but
+// the anchor acts on body + tether, so their momentum changes by the anchor's impulse,
+// -sum h F_a. bdf2's momentum is its scheme's: its balance M (3 v_n+1 - 4 v_n + v_n-1)/2 =
+// h f_n+1 conserves M (3 v_n - v_n-1)/2 on the nodes between the ends (end node B takes a
+// backward-Euler step, as the body does); the others M v_n. node_b: end node B counted (its
+// inertia is in the step). stopped: the divergence message, if any.
+struct MomentumBalance {
+  Eigen::Vector3d change = Eigen::Vector3d::Zero(), impulse = Eigen::Vector3d::Zero();
+  double peak = 0;      // [N s] norm of the largest impulse reached, component by component
+  double mismatch = 0;  // [N s] |change - impulse|
+  std::string stopped;
+};
+MomentumBalance RunMomentumBalance(mjModel* m, mjData* d, double body_mass, bool bdf2,
+                                   bool node_b) {
+  MomentumBalance r;
+  d->qvel[0] = 0.1;  // [m/s]
+  const Tether* t = GetTether(m, 0);
+  const double h = m->opt.timestep;
+  std::vector<double> before(3 * t->nodes());
+  auto momentum = [&]() {
+    Eigen::Vector3d p = body_mass * Eigen::Vector3d(d->qvel[0], d->qvel[1], d->qvel[2]);
+    const double* v = NodeVelocities(m, d, 0);
+    for (int i = 1; i < t->nodes() - (node_b ? 0 : 1); ++i) {
+      Eigen::Vector3d vi(v + 3 * i);
+      if (bdf2 && i < t->nodes() - 1) vi = 1.5 * vi - 0.5 * Eigen::Vector3d(&before[3 * i]);
+      p += t->node_mass(i) * vi;
+    }
+    return p;
+  };
+  // The first step sets the initial shape (the body's 0.1 m/s, end node's too) and steps the
+  // tether ahead by backward Euler (bdf2 has no history yet): the velocities before it are the
+  // initial shape's.
+  {
+    Ends e;
+    e.b.pos = Eigen::Vector3d(10.001, 0, 0);
+    e.b.vel = Eigen::Vector3d(0.1, 0, 0);
+    std::vector<double> x0(before.size());
+    t->InitialShape(e, x0.data(), before.data());
+  }
+  mj_step(m, d);
+  const Eigen::Vector3d p0 = momentum();
+  Eigen::Vector3d peak = Eigen::Vector3d::Zero();
+  for (int k = 0; k < 250; ++k) {
+    const double* v = NodeVelocities(m, d, 0);
+    std::copy(v, v + before.size(), before.begin());
+    mj_step(m, d);
+    if (auto why = CheckDivergence(m, d)) {
+      r.stopped = *why;
+      return r;
+    }
+    r.impulse -= h * GetReactions(m, d, 0).force_a;
+    peak = peak.cwiseMax(r.impulse.cwiseAbs());
+  }
+  r.change = momentum() - p0;
+  r.peak = peak.norm();
+  r.mismatch = (r.change - r.impulse).norm();
+  return r;
+}
+
 // Momentum: a free 5 kg body (no gravity, no water, no damping) 10.001 m from a fixed anchor on
 // a 10 m tether of ten 1 m segments, EA 1e7 (k_end 1e7 N/m: omega h = 2.8 at 2 ms), given
 // 0.1 m/s away from the anchor, 0.5 s at 2 ms. Nothing but the anchor acts on body + tether,
@@ -242,62 +303,21 @@ TEST_F(LightVehicle, MomentumChangeIsTheAnchorsImpulse) {
 </worldbody></mujoco>)";
     mjModel* m = Load(xml, "momentum.xml");
     ASSERT_NE(m, nullptr);
-    mjData* d = Make(m);
-    d->qvel[0] = 0.1;  // [m/s]
-    const Tether* t = GetTether(m, 0);
-    const double h = m->opt.timestep;
-    // bdf2: the momentum its balance M (3 v_n+1 - 4 v_n + v_n-1)/2 = h f_n+1 conserves is
-    // M (3 v_n - v_n-1)/2 on its nodes (those between the ends: end node B takes a
-    // backward-Euler step, as the body does); implicit: M v_n.
-    const bool bdf2 = std::string(integrator).rfind("bdf2", 0) == 0;
-    std::vector<double> before(3 * t->nodes());
     // End node B is not counted (session 11, s11coup), but with explicit: its inertia is taken
     // out of the implicit schemes' step, the node and the body moving as the body's mass alone,
     // as with the held force (counted, the balance read 1.9e-3 N s off of 0.39 N s with
     // implicit, its m_B dv_B).
-    const bool node_b = std::string(integrator) == "explicit";
-    auto momentum = [&]() {
-      Eigen::Vector3d p = 5 * Eigen::Vector3d(d->qvel[0], d->qvel[1], d->qvel[2]);
-      const double* v = NodeVelocities(m, d, 0);
-      for (int i = 1; i < t->nodes() - (node_b ? 0 : 1); ++i) {
-        Eigen::Vector3d vi(v + 3 * i);
-        if (bdf2 && i < t->nodes() - 1) vi = 1.5 * vi - 0.5 * Eigen::Vector3d(&before[3 * i]);
-        p += t->node_mass(i) * vi;
-      }
-      return p;
-    };
-    auto remember = [&]() {
-      const double* v = NodeVelocities(m, d, 0);
-      std::copy(v, v + before.size(), before.begin());
-    };
-    // The first step sets the initial shape (the body's 0.1 m/s, end node's too) and steps
-    // the tether ahead by backward Euler (bdf2 has no history yet): the velocities before it
-    // are the initial shape's.
-    {
-      Ends e;
-      e.b.pos = Eigen::Vector3d(10.001, 0, 0);
-      e.b.vel = Eigen::Vector3d(0.1, 0, 0);
-      std::vector<double> x0(before.size());
-      t->InitialShape(e, x0.data(), before.data());
-    }
-    mj_step(m, d);
-    const Eigen::Vector3d p0 = momentum();
-    Eigen::Vector3d impulse = Eigen::Vector3d::Zero(), peak = Eigen::Vector3d::Zero();
-    for (int k = 0; k < 250; ++k) {
-      remember();
-      mj_step(m, d);
-      ASSERT_FALSE(CheckDivergence(m, d)) << *CheckDivergence(m, d);
-      impulse -= h * GetReactions(m, d, 0).force_a;
-      peak = peak.cwiseMax(impulse.cwiseAbs());
-    }
-    const double mismatch = (momentum() - p0 - impulse).norm();
+    const MomentumBalance b =
+        RunMomentumBalance(m, Make(m), 5, std::string(integrator).rfind("bdf2", 0) == 0,
+                           std::string(integrator) == "explicit");
+    ASSERT_EQ(b.stopped, "") << integrator;
     std::printf("%s: momentum change %.4f N s, anchor's impulse %.4f N s (largest %.4f), "
                 "mismatch %.2e N s\n",
-                integrator, (momentum() - p0).x(), impulse.x(), peak.norm(), mismatch);
-    EXPECT_GT(peak.norm(), 0.3);  // the tether stopped and turned the body (about 1 N s)
+                integrator, b.change.x(), b.impulse.x(), b.peak, b.mismatch);
+    EXPECT_GT(b.peak, 0.3);  // the tether stopped and turned the body (about 1 N s)
     // Measured 1e-12 N s or less (bdf2 with damping 500: 1.2e-6 N s, its Newton tolerance);
     // the end node's inertia left in the step reads 0.5%.
-    EXPECT_LT(mismatch, 1e-5 * peak.norm()) << integrator;
+    EXPECT_LT(b.mismatch, 1e-5 * b.peak) << integrator;
   }
 }
 
@@ -330,49 +350,16 @@ TEST_F(LightVehicle, HeavyEndNodeIsCarriedByTheBodyAtAnyOmegaH) {
     EXPECT_LT(c.omega_h, 0.5) << integrator;  // below every integrator's lead threshold
     EXPECT_TRUE(c.heavy_node) << integrator;
     EXPECT_TRUE(c.consistent) << integrator;
-    mjData* d = Make(m);
-    d->qvel[0] = 0.1;  // [m/s]
-    const Tether* t = GetTether(m, 0);
-    const double h = m->opt.timestep;
-    const bool bdf2 = std::string(integrator) == "bdf2";
-    std::vector<double> before(3 * t->nodes());
     // Body and every node, end node B included (its inertia is in the step when it is
-    // heavier than the body); bdf2's nodes between the ends as in the test above.
-    auto momentum = [&]() {
-      Eigen::Vector3d p = 0.2 * Eigen::Vector3d(d->qvel[0], d->qvel[1], d->qvel[2]);
-      const double* v = NodeVelocities(m, d, 0);
-      for (int i = 1; i < t->nodes(); ++i) {
-        Eigen::Vector3d vi(v + 3 * i);
-        if (bdf2 && i < t->nodes() - 1) vi = 1.5 * vi - 0.5 * Eigen::Vector3d(&before[3 * i]);
-        p += t->node_mass(i) * vi;
-      }
-      return p;
-    };
-    {
-      Ends e;
-      e.b.pos = Eigen::Vector3d(10.001, 0, 0);
-      e.b.vel = Eigen::Vector3d(0.1, 0, 0);
-      std::vector<double> x0(before.size());
-      t->InitialShape(e, x0.data(), before.data());
-    }
-    mj_step(m, d);
-    const Eigen::Vector3d p0 = momentum();
-    Eigen::Vector3d impulse = Eigen::Vector3d::Zero(), peak = Eigen::Vector3d::Zero();
-    for (int k = 0; k < 250; ++k) {
-      const double* v = NodeVelocities(m, d, 0);
-      std::copy(v, v + before.size(), before.begin());
-      mj_step(m, d);
-      ASSERT_FALSE(CheckDivergence(m, d)) << *CheckDivergence(m, d);
-      impulse -= h * GetReactions(m, d, 0).force_a;
-      peak = peak.cwiseMax(impulse.cwiseAbs());
-    }
-    const double mismatch = (momentum() - p0 - impulse).norm();
+    // heavier than the body).
+    const MomentumBalance b =
+        RunMomentumBalance(m, Make(m), 0.2, std::string(integrator) == "bdf2", true);
+    ASSERT_EQ(b.stopped, "") << integrator;
     std::printf("%s (omega h %.2f): momentum change %.5f N s, anchor's impulse %.5f N s "
                 "(largest %.5f), mismatch %.2e N s\n",
-                integrator, c.omega_h, (momentum() - p0).x(), impulse.x(), peak.norm(),
-                mismatch);
-    EXPECT_GT(peak.norm(), 0.005) << integrator;  // the tether pulled the body back
-    EXPECT_LT(mismatch, 1e-5 * peak.norm()) << integrator;
+                integrator, c.omega_h, b.change.x(), b.impulse.x(), b.peak, b.mismatch);
+    EXPECT_GT(b.peak, 0.005) << integrator;  // the tether pulled the body back
+    EXPECT_LT(b.mismatch, 1e-5 * b.peak) << integrator;
   }
 }
 
