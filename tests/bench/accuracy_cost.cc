@@ -30,12 +30,14 @@
 #include <mujoco/mujoco.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
+#include <filesystem>
 #include <functional>
 #include <map>
 #include <memory>
@@ -50,6 +52,17 @@
 
 namespace mjtether {
 namespace {
+
+// fopen for writing, or exit 2 naming the path and the reason (a missing --out directory used
+// to crash in fwrite on a null FILE*).
+FILE* OpenForWriting(const std::string& path) {
+  FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) {
+    std::fprintf(stderr, "accuracy_cost: cannot write %s: %s\n", path.c_str(), std::strerror(errno));
+    std::exit(2);
+  }
+  return f;
+}
 
 using namespace reference_scenes;
 
@@ -169,7 +182,7 @@ Run RunRope(const Scene& s, int links, double h) {
     std::exit(3);
   }
   if (const char* dump = std::getenv("ACCURACY_COST_DUMP")) {
-    FILE* f = std::fopen((std::string(dump) + "/rope.xml").c_str(), "w");
+    FILE* f = OpenForWriting(std::string(dump) + "/rope.xml");
     std::fputs(xml.c_str(), f);
     std::fclose(f);
   }
@@ -318,7 +331,7 @@ void MarkPareto(std::vector<Run>* runs) {
 // accuracy_cost.md (a table per scene).
 void Write(const std::string& dir, std::vector<Run>* runs) {
   MarkPareto(runs);
-  FILE* csv = std::fopen((dir + "/accuracy_cost.csv").c_str(), "w");
+  FILE* csv = OpenForWriting(dir + "/accuracy_cost.csv");
   std::fprintf(csv,
                "scene,path,integrator,segments,step_s,outer_s,cpu_ms_per_s,wall_ms_per_s,"
                "err_T_N,err_T_time_N,err_x_m,mean_T_N,ok,pareto,pareto_series\n");
@@ -330,7 +343,7 @@ void Write(const std::string& dir, std::vector<Run>* runs) {
   }
   std::fclose(csv);
 
-  FILE* md = std::fopen((dir + "/accuracy_cost.md").c_str(), "w");
+  FILE* md = OpenForWriting(dir + "/accuracy_cost.md");
   std::string scene;
   for (const Run& r : *runs) {
     if (r.scene != scene) {
@@ -402,6 +415,12 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+  // The output directory is made before the runs, so that a bad one stops at once.
+  if (std::error_code ec; !std::filesystem::create_directories(o.out, ec) && ec) {
+    std::fprintf(stderr, "accuracy_cost: cannot create --out %s: %s\n", o.out.c_str(),
+                 ec.message().c_str());
+    return 2;
+  }
   InstallErrorHandlers();
   std::map<std::string, Scene> all = {{"line", LineScene()},
                                       {"catenary", CatenaryScene()},
@@ -470,7 +489,7 @@ int main(int argc, char** argv) {
         std::ostringstream f;
         f << dump << "/" << r.scene << "_" << r.path << "_" << r.integrator << "_" << r.segments
           << "_" << r.step << ".txt";
-        FILE* out = std::fopen(f.str().c_str(), "w");
+        FILE* out = OpenForWriting(f.str());
         for (size_t k = 0; k < r.T.size() && k < finest.T.size(); ++k) {
           std::fprintf(out, "%g %.9g %.9g %.9g\n", k * s.sample, r.T[k], finest.T[k],
                        ref_n[r.segments].T[k]);
