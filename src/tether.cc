@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 #include <complex>
 
 #include "detail/work.h"
@@ -322,6 +323,98 @@ int Tether::DragSubsteps(const double* xp, const double* vp, const Ends& from, c
 // ---------------------------------------------------------------------------------------------
 // Initial shape
 
+// The static shape of the discrete chain itself (the funicular polygon): its interior nodes
+// carry their net weights W_k (along `down`) and its segments are straight, of the length
+// their tension gives them, l_i = L0 (1 + T_i/EA). With H the horizontal tension (the same in
+// every segment, no horizontal load) and V_i the vertical force of segment i on its node i,
+// equilibrium at node k gives V_k = V_{k-1} + W_k, so
+//   V_i = V_0 + sum_{k=1..i} W_k,   T_i = sqrt(H^2 + V_i^2),
+//   sum_i l_i H / T_i = h,   sum_i l_i V_i / T_i = v   (h, v: horizontal and vertical span).
+// The vertical sum rises monotonically with V_0 (bisection for each H), and the horizontal one
+// with H (bisection on log H). This is the catenary's discrete counterpart (Irvine, "Cable
+// Structures", 1981, sec. 1.2 for the polygon of a cable under point loads): the continuous
+// catenary sampled at arc spacing L0 puts every chord short of L0 by ~L0^3 kappa^2/24, so
+// every segment starts slack, the nodes fall and the line snaps taut at the first steps. On
+// the polygon every segment starts at the tension that holds its nodes. A line without net
+// weight (neutral, or no gravity) has no such shape: every slack shape is at rest, and the
+// catenary stays. Returns false (x untouched) then, and where no bracket is found.
+bool Tether::HangChain(const Vec3& A, const Vec3& eh, const Vec3& up, double h, double vspan,
+                       bool elastic, Nodes x) const {
+  const int n = N_;
+  std::vector<double> W(n, 0.0);  // [N] W[i] = sum of the weights of nodes 1..i
+  const Vec3 down = -up;
+  bool weighted = true;
+  for (int k = 1; k < n; ++k) {
+    if (!(Weight(k).dot(down) > 0)) weighted = false;
+  }
+  if (!weighted || n < 2) return false;
+  for (int i = 1; i < n; ++i) W[i] = W[i - 1] + Weight(i).dot(down);
+  const double Wt = W[n - 1];  // [N] the load the polygon carries
+  // The axial law at rest, T = EA strain (inextensible where `elastic` is false).
+  const double flex = elastic && p_.EA > 0 ? 1.0 / p_.EA : 0.0;  // [1/N]
+  auto span = [&](double H, double V0, double* dx, double* dz) {
+    double sx = 0, sz = 0;
+    for (int i = 0; i < n; ++i) {
+      const double V = V0 + W[i], T = std::hypot(H, V), l = L0_ * (1 + T * flex);
+      sx += l * H / T;
+      sz += l * V / T;
+    }
+    *dx = sx;
+    *dz = sz;
+  };
+  // V_0 that closes the vertical span for this H.
+  auto vertical = [&](double H) {
+    double lo = -Wt - H, hi = H, dx, dz;
+    for (int it = 0; it < 200; ++it) {
+      span(H, lo, &dx, &dz);
+      if (dz < vspan) break;
+      lo = 2 * lo - hi;
+    }
+    for (int it = 0; it < 200; ++it) {
+      span(H, hi, &dx, &dz);
+      if (dz > vspan) break;
+      hi = 2 * hi - lo;
+    }
+    for (int it = 0; it < 200 && hi - lo > 1e-15 * (std::abs(lo) + std::abs(hi)); ++it) {
+      const double mid = 0.5 * (lo + hi);
+      span(H, mid, &dx, &dz);
+      (dz < vspan ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+  };
+  double llo = std::log(1e-12 * Wt), lhi = std::log(1e12 * Wt);
+  auto horizontal = [&](double logH) {
+    const double H = std::exp(logH), V0 = vertical(H);
+    double dx, dz;
+    span(H, V0, &dx, &dz);
+    return dx - h;
+  };
+  if (!(horizontal(llo) < 0) || !(horizontal(lhi) > 0)) return false;
+  for (int it = 0; it < 200 && lhi - llo > 1e-14; ++it) {
+    const double mid = 0.5 * (llo + lhi);
+    (horizontal(mid) < 0 ? llo : lhi) = mid;
+  }
+  const double H = std::exp(0.5 * (llo + lhi)), V0 = vertical(H);
+  // A line too soft to hold its own weight within a quarter of max_strain (the fuzzer's seeds
+  // 1575, 5320: w L / EA = 2.1 and 0.98) would start near the divergence check's limit and
+  // cross it at the first step: it hangs as the inextensible polygon instead and stretches
+  // from there, as it does from the catenary.
+  if (flex > 0) {
+    double strain = 0;
+    for (int i = 0; i < n; ++i) strain = std::max(strain, std::hypot(H, V0 + W[i]) * flex);
+    if (strain > 0.25 * p_.max_strain) return HangChain(A, eh, up, h, vspan, false, x);
+  }
+  Eigen::Matrix3Xd y(3, n);
+  y.col(0) = A;
+  for (int i = 0; i + 1 < n; ++i) {
+    const double V = V0 + W[i], T = std::hypot(H, V), l = L0_ * (1 + T * flex);
+    y.col(i + 1) = y.col(i) + l * (H * eh + V * up) / T;
+  }
+  if (!y.allFinite()) return false;
+  x.leftCols(n) = y;
+  return true;
+}
+
 void Tether::InitialShape(const Ends& ends, double* xp, double* vp) const {
   Nodes x(xp, 3, N_ + 1), v(vp, 3, N_ + 1);
   v.setZero();
@@ -386,6 +479,24 @@ void Tether::InitialShape(const Ends& ends, double* xp, double* vp) const {
     };
     const Curve c = solve(L);
     for (int k = 0; k <= N_; ++k) x.col(k) = point(c, c.sA + L * k / N_);
+    // A weighted line: the chain at rest (HangChain). Not where it dips below the seabed: the
+    // path lying on the seabed (RestOnSeabed) is built for the inextensible length, and where
+    // only the stretched chain reaches the seabed it has no grounded part (the fuzzer's seed
+    // 4658: a node 4 m from the next); the catenary, clear of the seabed, is kept there.
+    Eigen::Matrix3Xd chain = x;
+    if (HangChain(A, eh, up, h, vspan, true, Nodes(chain.data(), 3, N_ + 1))) {
+      chain.col(N_) = B;
+      bool grounded = false;
+      for (int k = 1; k < N_ && Has(kSeabed) && !grounded; ++k) {
+        grounded = chain(2, k) < env_.water.SeabedHeight(chain(0, k), chain(1, k));
+      }
+      if (!grounded) {
+        x = chain;
+        v.col(0) = ends.a.vel;
+        v.col(N_) = ends.b.vel;
+        return;
+      }
+    }
     // With compression, nodes at arc spacing L0 would start compressed (a chord is shorter than
     // its arc by ~L0^3 kappa^2 / 24) and spring apart at the first step. Instead walk chords of
     // exactly L0 along a catenary a little longer than L, its length found by the secant method

@@ -341,6 +341,8 @@ class Tether {
   void AccumulateContactImpulse(const double* x, const double* v, const Ends& ends, double weight,
                                 bool to_stage) const;
 
+  bool HangChain(const Vec3& A, const Vec3& eh, const Vec3& up, double h, double vspan,
+                 bool elastic, Nodes x) const;
   void RestOnSeabed(const Ends& ends, Nodes x) const;
   // Replaces a shape below the level zb (true), or leaves it (false).
   bool RestOnLevel(const Ends& ends, double zb, Nodes x) const;

@@ -54,34 +54,83 @@ TEST(BandCholesky, ReportsIndefiniteMatrix) {
   EXPECT_EQ(B.Factor(), 1);
 }
 
-// The slack initial shape is a catenary of the declared length through both ends, never a
-// compressed straight line.
-TEST(InitialShape, SlackCatenaryHasDeclaredLength) {
+// The slack initial shape of a weighted line is the discrete chain's own static shape (the
+// funicular polygon, Tether::HangChain): every interior node is at rest under its weight and
+// its two segments' tensions EA strain. Oracle: the tether's own force evaluation at t = 0,
+// whose largest nodal force must be round-off against the node's weight (1e-9; the bisections
+// close the spans to ~1e-14 L; measured 2e-13 and 7e-11). The catenary sampled at arc spacing,
+// the start before session 24, puts every chord short of L0 (here by 1.8% of L0 with 4
+// segments, 1.8e-4 with 40): every segment starts slack and every node is out of balance by
+// its whole weight (measured with that start: 1.00 of the node weight, all segments slack). The polygon's chords are L0 (1 + T/EA), so
+// its length exceeds L by the mean strain, and it lies in the vertical plane of the ends.
+TEST(InitialShape, SlackStartIsTheChainAtRest) {
   Environment env;
+  for (int n : {4, 40}) {
+    Sim s(Make(CatenaryParams(n), env));
+    s.ends.a.pos = Vec3(0, 0, 0);
+    s.ends.b.pos = Vec3(60, 30, 20);
+    s.Init();
+    std::vector<double> f(3 * s.tether.nodes()), T(n);
+    s.tether.ComputeForces(s.x.data(), s.v.data(), s.ends, f.data(), T.data(), s.work.data());
+    const double weight = 1.0 * 100.0 / n * 9.81;  // [N] one interior node (no water)
+    double worst = 0, length = 0, strain = 0, lowest = 0, slack = 0;
+    for (int i = 1; i < n; ++i) worst = std::max(worst, Vec3(&f[3 * i]).norm() / weight);
+    for (int i = 0; i < n; ++i) {
+      const double l = (s.node(i + 1) - s.node(i)).norm();
+      length += l;
+      strain += T[i] / 1e5 * (100.0 / n);  // [m] the stretch EA strain gives each segment
+      if (T[i] <= 0) ++slack;
+    }
+    for (int i = 0; i <= n; ++i) lowest = std::min(lowest, s.node(i).z());
+    std::printf("%d segments: largest nodal force %.2e of the node weight, %g slack, length %.6f "
+                "m, sag to z = %.3f m\n", n, worst, slack, length, lowest);
+    EXPECT_LT(worst, 1e-9);
+    EXPECT_EQ(slack, 0);
+    EXPECT_NEAR(length, 100 + strain, 1e-9 * 100);
+    EXPECT_LT(lowest, -10);  // it sags
+    EXPECT_EQ((s.node(0) - s.ends.a.pos).norm(), 0);
+    EXPECT_EQ((s.node(n) - s.ends.b.pos).norm(), 0);
+    const Vec3 normal = Vec3(60, 30, 0).cross(Vec3::UnitZ()).normalized();
+    for (int i = 0; i <= n; ++i) EXPECT_NEAR(s.node(i).dot(normal), 0, 1e-9);
+  }
+}
+
+// Without net weight (no gravity here; a neutral line likewise) every slack shape is at rest and
+// the start stays the catenary of the declared length, its chords short of L0 (slack).
+TEST(InitialShape, WeightlessSlackStartIsTheCatenary) {
+  Environment env;
+  env.gravity = Vec3::Zero();
   Sim s(Make(CatenaryParams(40), env));
   s.ends.a.pos = Vec3(0, 0, 0);
   s.ends.b.pos = Vec3(60, 30, 20);
   s.Init();
-  double length = 0, lowest = 0;
+  double length = 0;
   for (int i = 0; i < 40; ++i) length += (s.node(i + 1) - s.node(i)).norm();
-  for (int i = 0; i <= 40; ++i) lowest = std::min(lowest, s.node(i).z());
   // Chords of a curve of length L are shorter than L by O(L0^2 kappa^2 / 24) each.
   EXPECT_NEAR(length, 100, 0.05);
   EXPECT_LT(length, 100);
-  EXPECT_LT(lowest, -10);  // it sags
-  EXPECT_EQ((s.node(0) - s.ends.a.pos).norm(), 0);
-  EXPECT_EQ((s.node(40) - s.ends.b.pos).norm(), 0);
-  // Every node lies in the vertical plane through both ends.
-  const Vec3 normal = Vec3(60, 30, 0).cross(Vec3::UnitZ()).normalized();
-  for (int i = 0; i <= 40; ++i) EXPECT_NEAR(s.node(i).dot(normal), 0, 1e-9);
 }
 
 // With compression a segment shorter than L0 pushes, so the slack initial shape must not
-// start compressed: every chord is L0 (to 1e-9 relative; the walk converges to 1e-14), the
-// end nodes are on the sites, and the shape is the same catenary as without compression to
-// within the chord-versus-arc difference (the nodes move by less than 1% of L0 here).
+// start compressed. Weighted, the chain at rest has every chord at least L0. Weightless (the
+// catenary), every chord is L0 (to 1e-9 relative; the walk converges to 1e-14), the end nodes
+// are on the sites, and the shape is the same catenary as without compression to within the
+// chord-versus-arc difference (the nodes move by less than 1% of L0 here).
 TEST(InitialShape, WithCompressionEveryChordIsTheRestLength) {
+  {
+    Environment env;
+    TetherParams p = CatenaryParams(40);
+    p.EAc = 1e5;
+    Sim s(Make(p, env));
+    s.ends.a.pos = Vec3(0, 0, 0);
+    s.ends.b.pos = Vec3(60, 30, 20);
+    s.Init();
+    double shortest = INFINITY;
+    for (int i = 0; i < 40; ++i) shortest = std::min(shortest, (s.node(i + 1) - s.node(i)).norm());
+    EXPECT_GE(shortest, 2.5 * (1 + 1e-6)) << "weighted: every segment taut";
+  }
   Environment env;
+  env.gravity = Vec3::Zero();
   TetherParams p = CatenaryParams(40);
   Sim plain(Make(p, env));
   p.EAc = 1e5;
