@@ -304,11 +304,21 @@ std::string EffectsToString(unsigned effects) {
   return s;
 }
 
+double SegmentModeDamping(const TetherParams& p, double zeta) {
+  const double L0 = p.length / p.segments;  // [m]
+  return zeta * L0 * std::sqrt(p.EA * p.mass_per_length);
+}
+
+double SegmentModeFrequency(const TetherParams& p) {
+  const double L0 = p.length / p.segments;  // [m]
+  return 2 / L0 * std::sqrt(p.EA / p.mass_per_length);
+}
+
 std::optional<TetherDeclaration> ParseTether(const std::string& text, const Environment& env,
                                              DeclarationError* error) {
   static const char* const kKeys[] = {
       "ends",    "length", "segments",   "diameter", "mass_per_length", "EA",
-      "EI",      "damping", "Cdn",       "Cdt",      "Can",             "integrator",
+      "EI",      "damping", "damping_ratio", "Cdn",  "Cdt",      "Can",  "integrator",
       "clamp",   "effects", "substeps",  "max_step", "max_strain", "bending",
       "EAc",     "contact", "contact_stiffness", "contact_damping", "contact_friction",
       "contact_friction_speed", "start"};
@@ -353,6 +363,8 @@ std::optional<TetherDeclaration> ParseTether(const std::string& text, const Envi
       ok = ParseInRange(key, value, {0, 1e12, false}, &p.EI, error);
     } else if (key == "damping") {
       ok = ParseInRange(key, value, {0, 1e12, false}, &p.damping, error);
+    } else if (key == "damping_ratio") {
+      ok = ParseInRange(key, value, {0, 10, false}, &p.damping_ratio, error);
     } else if (key == "Cdn") {
       ok = ParseInRange(key, value, {0, 100, false}, &p.Cdn, error);
     } else if (key == "Cdt") {
@@ -450,6 +462,16 @@ std::optional<TetherDeclaration> ParseTether(const std::string& text, const Envi
          "key 'contact_friction' > 0 is not supported with integrator=implicit2 yet; use "
          "integrator=implicit, explicit or rk4, or contact_friction=0");
     return std::nullopt;
+  }
+  if (p.damping_ratio >= 0) {
+    bool both = false;
+    for (const auto& kv : *pairs) both |= kv.first == "damping";
+    if (both) {
+      Fail(error, "damping_ratio",
+           "keys 'damping' [N s] and 'damping_ratio' [-] exclude each other; give one");
+      return std::nullopt;
+    }
+    p.damping = SegmentModeDamping(p, p.damping_ratio);
   }
   if (p.substeps > 0 && p.max_step > 0) {
     Fail(error, "substeps", "keys 'substeps' and 'max_step' exclude each other; give one");

@@ -42,6 +42,17 @@ struct TetherDeclaration {
   std::string contact;
 };
 
+// [N s] The internal damping that gives the tether's segment axial mode the damping ratio
+// zeta: adjacent nodes moving in opposite directions along the line, each segment's midpoint at
+// rest. Each node of mass m = mass_per_length L0 sits between two half segments, so
+//   m u'' + (4 damping / L0) u' + (4 EA / L0) u = 0,  omega_n = (2 / L0) sqrt(EA / mass_per_length),
+// and zeta = damping / (L0 sqrt(EA mass_per_length)) (the relation of MoorDyn's BA/-zeta input,
+// docs/reference.md "Internal damping"). The mode is the discretisation's own, at the highest
+// axial frequency of the line; a lower mode of frequency s omega_n (s < 1) gets s zeta.
+double SegmentModeDamping(const TetherParams& p, double zeta);
+// [rad/s] omega_n above.
+double SegmentModeFrequency(const TetherParams& p);
+
 // Parses the water declaration.
 std::optional<Water> ParseWater(const std::string& text, DeclarationError* error);
 

@@ -118,6 +118,9 @@ struct TetherParams {
   double EAc = 0;              // [N] axial stiffness in compression (l < L0); 0: tension only
   double EI = 0;               // [N m^2] bending stiffness
   double damping = 0;          // [N s] internal axial damping: T = EA*eps + damping*deps/dt
+  // [-] `damping_ratio=` as declared (MoorDyn's BA = -zeta): the damping ratio of the
+  // segment axial mode, from which the parser sets damping (SegmentModeDamping); < 0: not given
+  double damping_ratio = -1;
   double Cdn = 0;              // [-] normal drag coefficient, reference area d per length
   double Cdt = 0;              // [-] tangential drag coefficient, reference area pi*d per length
   double Can = 0;              // [-] normal added-mass coefficient, reference pi*d^2/4 per length

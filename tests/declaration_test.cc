@@ -1,5 +1,7 @@
 // Tests of the declaration parser: every class of bad input gets a message naming the key
 // and, for numbers, the allowed range.
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include <ostream>
@@ -150,10 +152,32 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"EAc negative", With("EAc=2e5", "EAc=-2e5"), "EAc", "(0, 1e+13]"},
         BadCase{"EAc huge", With("EAc=2e5", "EAc=1e14"), "EAc", "(0, 1e+13]"},
         BadCase{"compression without EAc", With("EAc=2e5 ", "") + " effects=axial,compression",
-                "effects", "EAc > 0"}),
+                "effects", "EAc > 0"},
+        BadCase{"damping ratio negative", With("damping=50", "damping_ratio=-0.1"),
+                "damping_ratio", "[0, 10]"},
+        BadCase{"damping ratio huge", With("damping=50", "damping_ratio=11"), "damping_ratio",
+                "[0, 10]"},
+        BadCase{"damping and damping ratio", With("damping=50", "damping=50 damping_ratio=1"),
+                "damping_ratio", "exclude each other"}),
     [](const ::testing::TestParamInfo<BadCase>& info) {
       return testing::ParamName(info.param.what);
     });
+
+// damping_ratio is the damping of the segment axial mode (MoorDyn's BA = -zeta): c = zeta L0
+// sqrt(EA mu), here 0.5 x 1 m x sqrt(2e5 x 0.35) = 132.29 N s; 0 declares no damping effect.
+TEST(Declaration, DampingRatioSetsTheSegmentModeDamping) {
+  DeclarationError e;
+  std::optional<TetherDeclaration> d =
+      ParseTether(With("damping=50", "damping_ratio=0.5"), Wet(), &e);
+  ASSERT_TRUE(d) << e.message;
+  EXPECT_NEAR(d->params.damping, 0.5 * 1.0 * std::sqrt(2e5 * 0.35), 1e-9);
+  EXPECT_DOUBLE_EQ(d->params.damping_ratio, 0.5);
+  EXPECT_NE(d->params.effects & kDamping, 0u);
+  d = ParseTether(With("damping=50", "damping_ratio=0"), Wet(), &e);
+  ASSERT_TRUE(d) << e.message;
+  EXPECT_EQ(d->params.damping, 0.0);
+  EXPECT_EQ(d->params.effects & kDamping, 0u);
+}
 
 TEST(Declaration, MalformedTextIsRejected) {
   DeclarationError e;
