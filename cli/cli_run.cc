@@ -323,6 +323,9 @@ int Run(const RunOptions& opt) {
   for (const std::string& w : mjtether::StallWarnings(mm, d)) {
     std::cerr << "mjtether: warning: " << w << "\n";
   }
+  for (const std::string& w : mjtether::RingWarnings(mm, d)) {
+    std::cerr << "mjtether: warning: " << w << "\n";
+  }
   for (OutputFile* f : {&log, &nodes}) {
     if (!f->Commit(&error)) {
       std::cerr << "mjtether: " << error << "\n";
@@ -414,6 +417,19 @@ int Info(const std::string& path, const std::vector<std::string>& set) {
     if (st.w_bending > 0) std::cout << ", bending omega " << st.w_bending << " rad/s";
     if (st.w_seabed > 0) std::cout << ", seabed omega " << st.w_seabed << " rad/s";
     std::cout << ", damping rate " << st.rate << " 1/s\n";
+    // The segment axial mode (docs/reference.md "Internal damping"): the ringing after a snap
+    // that an implicit step damps and a smaller one resolves (RingWarnings at a run's end).
+    const double h_tether = m->opt.timestep / std::max(1, t->SubstepsFor(m->opt.timestep));
+    std::cout << "    segment axial mode: omega_n " << t->SegmentModeFrequency()
+              << " rad/s, omega_n h " << t->SegmentModeFrequency() * h_tether
+              << ", damping ratio " << t->SegmentModeRatio()
+              << (t->SegmentModeRatio() < mjtether::kRingDampingRatio &&
+                          t->SegmentModeFrequency() * h_tether > 1 &&
+                          !mjtether::IsExplicit(p.integrator)
+                      ? " (undamped and not resolved: a snap's ringing depends on the step; "
+                        "damping_ratio=1 damps it)"
+                      : "")
+              << "\n";
     const double cost = mjtether::EstimatedCostPerSecond(*t, m->opt.timestep);
     std::cout << "    estimated cost " << cost << " s of CPU per simulated second ("
               << (cost > 0 ? 1 / cost : 0) << "x real time)\n";

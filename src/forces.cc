@@ -505,6 +505,30 @@ double Tether::EndStiffness() const {
 
 double Tether::EndDamping() const { return Has(kDamping) ? p_.damping / L0_ : 0.0; }
 
+double Tether::SegmentModeFrequency() const {
+  return 2 / L0_ * std::sqrt(p_.EA / p_.mass_per_length);
+}
+
+double Tether::SegmentModeRatio() const {
+  return Has(kDamping) ? p_.damping / (L0_ * std::sqrt(p_.EA * p_.mass_per_length)) : 0.0;
+}
+
+double Tether::SnapJump(const double* xp, const double* vp, double dt) const {
+  ConstNodes x(xp, 3, N_ + 1), v(vp, 3, N_ + 1);
+  double fastest = 0;  // [m/s]
+  for (int j = 0; j < N_; ++j) {
+    const double rest = rest_length(j);
+    const Vec3 d = x.col(j + 1) - x.col(j);
+    const double l2 = d.squaredNorm();
+    if (!(l2 < rest * rest)) continue;  // taut (or not finite: Check reports that)
+    const double closing = (v.col(j + 1) - v.col(j)).dot(d);  // [m^2/s] = l x separation speed
+    if (!(closing > 0)) continue;
+    const double l = std::sqrt(l2), speed = closing / l;
+    if (l + dt * speed >= rest) fastest = std::max(fastest, speed);
+  }
+  return std::sqrt(p_.EA * p_.mass_per_length) * fastest;
+}
+
 // Tension only: a compressed segment (compression effect) reads 0, like a slack one.
 void Tether::Tensions(const double* xp, const double* vp, double* T) const {
   ConstNodes x(xp, 3, N_ + 1), v(vp, 3, N_ + 1);

@@ -273,6 +273,17 @@ class Tether {
   // end-damping bound read it.
   double EndDamping() const;
 
+  // The segment axial mode (docs/reference.md "Internal damping"): adjacent nodes moving in
+  // opposite directions along the line, omega_n = (2/L0) sqrt(EA/mu) [rad/s], and its damping
+  // ratio damping / (L0 sqrt(EA mu)) [-] (0 without the damping effect).
+  double SegmentModeFrequency() const;
+  double SegmentModeRatio() const;
+  // [N] The largest snap a step of dt from the state (x, v) would start: over the slack
+  // segments whose nodes separate fast enough to reach the rest length within dt, the axial
+  // wave's tension jump sqrt(EA mu) times the separation speed (0 if none). A cheap look-ahead
+  // (one pass of squared lengths; a root only for such segments) for the plugin's snap check.
+  double SnapJump(const double* x, const double* v, double dt) const;
+
   // The terms of the explicit stability limit (see Create), each the largest over the dynamic
   // nodes of its node-by-node bound: natural frequencies of the axial chain, the bending
   // operator and the seabed [rad/s] (0 when the effect is off), and the damping rate [1/s]
