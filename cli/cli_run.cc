@@ -424,10 +424,10 @@ int Info(const std::string& path, const std::vector<std::string>& set) {
               << " rad/s, omega_n h " << t->SegmentModeFrequency() * h_tether
               << ", damping ratio " << t->SegmentModeRatio()
               << (t->SegmentModeRatio() < mjtether::kRingDampingRatio &&
-                          t->SegmentModeFrequency() * h_tether > 1 &&
+                          t->SegmentModeFrequency() * h_tether > mjtether::kRingOmegaH &&
                           !mjtether::IsExplicit(p.integrator)
-                      ? " (undamped and not resolved: a snap's ringing depends on the step; "
-                        "damping_ratio=1 damps it)"
+                      ? " (undamped but for the step's numerical damping: a snap's ringing makes the "
+                        "tensions depend on the step; damping_ratio=1 damps it)"
                       : "")
               << "\n";
     const double cost = mjtether::EstimatedCostPerSecond(*t, m->opt.timestep);
