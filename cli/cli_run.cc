@@ -423,9 +423,7 @@ int Info(const std::string& path, const std::vector<std::string>& set) {
     std::cout << "    segment axial mode: omega_n " << t->SegmentModeFrequency()
               << " rad/s, omega_n h " << t->SegmentModeFrequency() * h_tether
               << ", damping ratio " << t->SegmentModeRatio()
-              << (t->SegmentModeRatio() < mjtether::kRingDampingRatio &&
-                          t->SegmentModeFrequency() * h_tether > mjtether::kRingOmegaH &&
-                          !mjtether::IsExplicit(p.integrator)
+              << (mjtether::WatchesRinging(*t, m->opt.timestep)
                       ? " (undamped but for the step's numerical damping: a snap's ringing makes the "
                         "tensions depend on the step; damping_ratio=1 damps it)"
                       : "")

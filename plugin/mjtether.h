@@ -198,6 +198,10 @@ inline constexpr double kRingDampingRatio = 0.1;
 // damping_ratio=1 brought to agree with their fine step was 0.06 (session 25); below 0.05 a
 // period spans more than 125 steps.
 inline constexpr double kRingOmegaH = 0.05;
+// Whether a tether stepped over `timestep` [s] has its snaps watched for that ringing: an
+// implicit integrator, the segment mode's damping ratio below kRingDampingRatio and its
+// omega_n h above kRingOmegaH (h: the tether's own step). A winch tether is not watched either.
+bool WatchesRinging(const Tether& t, double timestep);
 
 // Replaces MuJoCo's default error handler (which waits on stdin) by one that prints the
 // message and exits with status 3, and routes warnings to stderr. Idempotent.

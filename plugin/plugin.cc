@@ -461,15 +461,21 @@ void StartWinchShape(const AttachedTether& at, const Tether& tether, double* u, 
 constexpr double kRingBigJump = 1.0;    // [N]
 constexpr double kRingJump = 0.1;       // [N] below the fuzzer's 0.5 N tension tolerance
 constexpr double kRingRelative = 0.02;  // [-] of the larger end tension, below its 5%
+}  // namespace
+
+bool WatchesRinging(const Tether& t, double timestep) {
+  if (IsExplicit(t.params().integrator) || !(t.SegmentModeRatio() < kRingDampingRatio)) {
+    return false;
+  }
+  const int substeps = t.SubstepsFor(timestep);
+  return substeps > 0 && t.SegmentModeFrequency() * timestep / substeps > kRingOmegaH;
+}
+
+namespace {
 void WatchSnaps(const AttachedTether& at, const double* x, const double* v, double dt,
                 double time, double* u) {
   const Tether& t = at.tether;
-  if (at.winch || IsExplicit(t.params().integrator) ||
-      !(t.SegmentModeRatio() < kRingDampingRatio)) {
-    return;
-  }
-  const int substeps = t.SubstepsFor(dt);
-  if (substeps <= 0 || !(t.SegmentModeFrequency() * dt / substeps > kRingOmegaH)) return;
+  if (at.winch || !WatchesRinging(t, dt)) return;
   const double jump = t.SnapJump(x, v, dt);
   // A snap of kRingBigJump counts; a smaller one where it is kRingRelative of the ends' last
   // tensions (0.1 N on a 1 MN line does not).

@@ -309,11 +309,6 @@ double SegmentModeDamping(const TetherParams& p, double zeta) {
   return zeta * L0 * std::sqrt(p.EA * p.mass_per_length);
 }
 
-double SegmentModeFrequency(const TetherParams& p) {
-  const double L0 = p.length / p.segments;  // [m]
-  return 2 / L0 * std::sqrt(p.EA / p.mass_per_length);
-}
-
 std::optional<TetherDeclaration> ParseTether(const std::string& text, const Environment& env,
                                              DeclarationError* error) {
   static const char* const kKeys[] = {

@@ -50,8 +50,6 @@ struct TetherDeclaration {
 // docs/reference.md "Internal damping"). The mode is the discretisation's own, at the highest
 // axial frequency of the line; a lower mode of frequency s omega_n (s < 1) gets s zeta.
 double SegmentModeDamping(const TetherParams& p, double zeta);
-// [rad/s] omega_n above.
-double SegmentModeFrequency(const TetherParams& p);
 
 // Parses the water declaration.
 std::optional<Water> ParseWater(const std::string& text, DeclarationError* error);

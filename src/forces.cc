@@ -505,14 +505,6 @@ double Tether::EndStiffness() const {
 
 double Tether::EndDamping() const { return Has(kDamping) ? p_.damping / L0_ : 0.0; }
 
-double Tether::SegmentModeFrequency() const {
-  return 2 / L0_ * std::sqrt(p_.EA / p_.mass_per_length);
-}
-
-double Tether::SegmentModeRatio() const {
-  return Has(kDamping) ? p_.damping / (L0_ * std::sqrt(p_.EA * p_.mass_per_length)) : 0.0;
-}
-
 double Tether::SnapJump(const double* xp, const double* vp, double dt) const {
   ConstNodes x(xp, 3, N_ + 1), v(vp, 3, N_ + 1);
   double fastest = 0;  // [m/s]

@@ -126,6 +126,11 @@ std::optional<Tether> Tether::Create(const TetherParams& params, const Environme
                               : Eigen::VectorXd::Zero(n);
   a.inv_mass = a.mass.cwiseInverse();
   c.damping_per_L0_ = params.damping / c.L0_;
+  // The segment axial mode (SegmentModeFrequency): read at every step by the plugin's snap watch.
+  c.segment_mode_w_ = 2 / c.L0_ * std::sqrt(params.EA / params.mass_per_length);
+  c.segment_mode_ratio_ =
+      c.Has(kDamping) ? params.damping / (c.L0_ * std::sqrt(params.EA * params.mass_per_length))
+                      : 0.0;
   a.inv_mass_normal = (a.mass + a.added).cwiseInverse();
   // Net weight: dry weight minus buoyancy of the displaced volume.
   a.weight = Eigen::Matrix3Xd::Zero(3, n);

@@ -276,8 +276,8 @@ class Tether {
   // The segment axial mode (docs/reference.md "Internal damping"): adjacent nodes moving in
   // opposite directions along the line, omega_n = (2/L0) sqrt(EA/mu) [rad/s], and its damping
   // ratio damping / (L0 sqrt(EA mu)) [-] (0 without the damping effect).
-  double SegmentModeFrequency() const;
-  double SegmentModeRatio() const;
+  double SegmentModeFrequency() const { return segment_mode_w_; }
+  double SegmentModeRatio() const { return segment_mode_ratio_; }
   // [N] The largest snap a step of dt from the state (x, v) would start: over the slack
   // segments whose nodes separate fast enough to reach the rest length within dt, the axial
   // wave's tension jump sqrt(EA mu) times the separation speed (0 if none). A cheap look-ahead
@@ -394,6 +394,8 @@ class Tether {
   bool dynamic_b_ = false;  // see WithDynamicEndB
   int N_ = 0;
   double L0_ = 0;               // [m] rest length of a segment
+  double segment_mode_w_ = 0;      // [rad/s] SegmentModeFrequency
+  double segment_mode_ratio_ = 0;  // [-] SegmentModeRatio
   double area_ = 0;             // [m^2] pi d^2 / 4
   double kn_ = 0, kt_ = 0;      // [kg/m^2] 1/2 rho Cdn d, 1/2 rho Cdt pi d (per length)
   // [1/m] the largest drag rate per unit speed of a dynamic node, 2 max(kn/(m + ma), kt/m) l_i

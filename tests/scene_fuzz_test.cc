@@ -1307,6 +1307,23 @@ thread_local bool t_shortened = false;
 thread_local bool t_stalled = false;
 thread_local bool t_held = false;
 
+// The twin of a warned run (the scene with the warned cause taken away: Cleared, Damped),
+// judged like any scene at 2 ms for `duration`: it agrees where it passes and its own run gives
+// no such warning (`warning`, a Run member). detail: "; LABEL: agrees: ..." (or its outcome, or
+// `missing` where the twin could not be made, an empty xml).
+struct Twin {
+  bool agrees = false;
+  std::string detail;
+};
+Twin JudgeTwin(const Scene& twin, double duration, const std::string& label,
+               const std::string& missing, std::string Run::*warning) {
+  if (twin.xml.empty()) return {false, "; " + label + ": " + missing};
+  const Run r = Simulate(twin, kStep, duration);
+  const Outcome to = Failed(r) ? Outcome{"failed", false, Why(r)} : Compare(twin, r);
+  return {to.pass && (r.*warning).empty(),
+          "; " + label + ": " + (to.pass ? "agrees: " : to.kind + ": ") + to.detail};
+}
+
 Outcome JudgeRuns(const Scene& s) {
   const Run coarse = Simulate(s, kStep);
   t_shortened = coarse.loaded && coarse.duration < kDuration;
@@ -1449,17 +1466,10 @@ Outcome JudgeRuns(const Scene& s) {
   // shape is judged too; where it agrees, the pressed start is the cause and the run did what
   // its warning said, a warned outcome; where it does not, the scene fails.
   if (step_dependent && WarnsContactStepDependence(coarse.contact_warning)) {
-    const Scene c = Cleared(s);
-    std::string cleared = "; geom moved clear: no place keeps the ends clear";
-    if (!c.xml.empty()) {
-      const Run cc = Simulate(c, kStep, coarse.duration);
-      const Outcome co = Failed(cc) ? Outcome{"failed", false, Why(cc)} : Compare(c, cc);
-      cleared = "; geom moved clear: " + (co.pass ? "agrees: " : co.kind + ": ") + co.detail;
-      if (co.pass && cc.contact_warning.empty()) {
-        return {kWarnedInside, true, o.kind + ": " + o.detail + cleared};
-      }
-    }
-    if (!coarse.stretched) return {o.kind, false, o.detail + cleared};
+    const Twin c = JudgeTwin(Cleared(s), coarse.duration, "geom moved clear",
+                             "no place keeps the ends clear", &Run::contact_warning);
+    if (c.agrees) return {kWarnedInside, true, o.kind + ": " + o.detail + c.detail};
+    if (!coarse.stretched) return {o.kind, false, o.detail + c.detail};
   }
   // A snap that rang the undamped segment axial mode (RingWarnings, session 25: the 2 ms step
   // damps the ringing, the 0.2 ms step resolves it, and the slack clip turns it into mean
@@ -1469,17 +1479,10 @@ Outcome JudgeRuns(const Scene& s) {
   // agrees, the undamped mode is the cause and the run did what its warning said, a warned
   // outcome; where it does not, the scene fails.
   if (step_dependent && !coarse.ring_warning.empty()) {
-    const Scene c = Damped(s);
-    std::string damped = "; with damping_ratio=1: the declaration is not the fuzzer's";
-    if (!c.xml.empty()) {
-      const Run cc = Simulate(c, kStep, coarse.duration);
-      const Outcome co = Failed(cc) ? Outcome{"failed", false, Why(cc)} : Compare(c, cc);
-      damped = "; with damping_ratio=1: " + (co.pass ? "agrees: " : co.kind + ": ") + co.detail;
-      if (co.pass && cc.ring_warning.empty()) {
-        return {kWarnedRing, true, o.kind + ": " + o.detail + damped};
-      }
-    }
-    if (!coarse.stretched) return {o.kind, false, o.detail + damped};
+    const Twin c = JudgeTwin(Damped(s), coarse.duration, "with damping_ratio=1",
+                             "the declaration is not the fuzzer's", &Run::ring_warning);
+    if (c.agrees) return {kWarnedRing, true, o.kind + ": " + o.detail + c.detail};
+    if (!coarse.stretched) return {o.kind, false, o.detail + c.detail};
   }
   if (o.kind != "disagrees with 10x smaller step" || !coarse.stretched) return o;
   // A stretched start (Attach warned "starts stretched": ends farther apart than the length,
