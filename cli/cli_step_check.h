@@ -65,6 +65,9 @@ struct Trace {
   double end_time = 0;             // [s] where the run ended
   std::optional<std::string> stop;  // why it stopped early (StepAndCheck's message)
   bool interrupted = false;         // by a signal or because the other run was
+  // The run's own end-of-run warnings (StallWarnings, RingWarnings), as `mjtether run` prints
+  // them for itself: a fine run that stalled or rang is a weaker reference, and says so.
+  std::vector<std::string> warnings;
 };
 
 class Recorder {
@@ -175,6 +178,9 @@ inline void RunFine(const mjModel* m, long long steps, const std::vector<int>& b
   }
   rec.Finish(m, d);
   *out = std::move(rec.trace());
+  for (std::vector<std::string> w : {StallWarnings(m, d), RingWarnings(m, d)}) {
+    out->warnings.insert(out->warnings.end(), w.begin(), w.end());
+  }
   mj_deleteData(d);
   done->store(true);
 }

@@ -17,6 +17,7 @@ MODELS = os.environ.get("MJTETHER_MODELS_DIR", mjtether.models_dir)
 CLI = os.environ.get("MJTETHER_CLI", "mjtether")
 REFERENCE = os.environ.get("MJTETHER_REFERENCE_RUN")
 ROV = os.path.join(MODELS, "bluerov2_heavy.xml")  # thrust schedule and a moving boat
+HOSTILE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "hostile")
 
 # Two straight tethers between world sites, no gravity, dry: each carries the uniform tension
 # EA (span / length - 1): "hot" 1.9e4 * (10 / 9.5 - 1) = 1000 N, "mid" 500 N (the same scene
@@ -302,6 +303,30 @@ def test_divergence_raises_the_cli_message(tmp_path):
     with pytest.raises(mjtether.DivergenceError) as e:
         sim.step(500)
     assert str(e.value) == message
+
+
+def test_run_warnings_are_what_the_cli_prints_at_the_end_of_a_run():
+    # tests/hostile/ringing.xml: an undamped bdf2 line whose slack segments snap taut within 1 s
+    # at omega_n h 7.5 (docs/reference.md, "Internal damping"). `mjtether run` warns at its end;
+    # a Python user reading only the result was told nothing before run_warnings.
+    path = os.path.join(HOSTILE, "ringing.xml")
+    out = subprocess.run([CLI, "run", path, "--duration", "1"], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    prefix = "mjtether: warning: "
+    cli = [line[len(prefix):] for line in out.stderr.splitlines() if line.startswith(prefix)]
+    assert len(cli) == 1 and "damping_ratio=1" in cli[0]
+    sim = mjtether.Simulation(path)
+    assert sim.run_warnings == []  # nothing has snapped at t = 0
+    twin = sim.copy()
+    sim.step(round(1 / sim.timestep))
+    assert sim.run_warnings == cli
+    twin.step(round(0.5 / twin.timestep))  # the copy carries its own record
+    assert len(twin.run_warnings) == 1
+    sim.reset()
+    assert sim.run_warnings == []
+    damped = mjtether.Simulation(path, set=["tether:t.damping_ratio=1"])
+    damped.step(round(1 / damped.timestep))
+    assert damped.run_warnings == []  # the cure the warning names silences it
 
 
 def test_bad_step_count_is_refused():
