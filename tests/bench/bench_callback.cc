@@ -5,6 +5,7 @@
 // no bending, fairlead on a mocap body moving x = 80 + 2 sin(2 pi t/10)), 2 ms steps, as the
 // accuracy/cost sweep runs it through MuJoCo; `x_real_time` is simulated seconds per CPU
 // second (issue 17's target: >= 250 at 100 segments, bdf2 and implicit).
+// BM_RingWatchOn/Off: the cost of the ringing watch (see Watch).
 //
 //   ./build/tests/bench/bench_callback --benchmark_repetitions=5
 //     --benchmark_report_aggregates_only=true
@@ -20,12 +21,14 @@
 
 namespace {
 
-std::string Scene(int segments, const char* integrator) {
+// `damping`: the internal damping key as declared ("damping=50" [N s], or "damping_ratio=Z").
+std::string Scene(int segments, const char* integrator, const std::string& damping = "damping=50") {
   std::ostringstream s;
   s << R"(<mujoco><option timestep="0.002"/><custom>
     <text name="water" data="density=1025 current=0.3,0,0"/>
     <text name="tether:u" data="ends=tms,rov length=20 segments=)"
-    << segments << R"( diameter=0.02 mass_per_length=0.322 EA=2e5 EI=0.5 damping=50
+    << segments << R"( diameter=0.02 mass_per_length=0.322 EA=2e5 EI=0.5 )"
+    << damping << R"(
           Cdn=1.2 Cdt=0.01 Can=1.0 integrator=)"
     << integrator << R"("/></custom>
     <worldbody><site name="tms" pos="0 0 0"/>
@@ -86,6 +89,33 @@ void Step(benchmark::State& state, const char* integrator, bool tether) {
   mj_deleteModel(m);
 }
 
+// The ringing watch's cost (RingWarnings, plugin/mjtether.h): the same bdf2 scene with the
+// segment mode's damping ratio just below kRingDampingRatio (watched: one pass over the
+// segments before each advance) and at it (not watched); both declare the damping effect, so
+// the difference is the watch alone. Skips if the predicate does not split them so.
+void Watch(benchmark::State& state, bool watched) {
+  const int segments = static_cast<int>(state.range(0));
+  std::ostringstream ratio;
+  ratio << "damping_ratio=" << (watched ? 0.99 : 1.0) * mjtether::kRingDampingRatio;
+  std::string error;
+  mjModel* m =
+      mjtether::LoadModelFromString(Scene(segments, "bdf2", ratio.str()), "b.xml", &error);
+  if (!m) {
+    state.SkipWithError(error.c_str());
+    return;
+  }
+  if (mjtether::WatchesRinging(*mjtether::GetTether(m, 0), m->opt.timestep) != watched) {
+    state.SkipWithError("the ringing watch is not what this benchmark assumes");
+  } else {
+    mjData* d = mj_makeData(m);
+    for (int k = 0; k < 500; ++k) mj_step(m, d);
+    TimeRestoring(state, m, d, 1000, segments, [&]() { mj_step(m, d); });
+    mj_deleteData(d);
+  }
+  mjtether::Detach(m);
+  mj_deleteModel(m);
+}
+
 // The fixed comparison line through mj_step at 2 ms (see the header): warmed up over its first
 // period (the snap from the inextensible catenary), then 10 s (one period of the fairlead)
 // before each restore of that state.
@@ -124,6 +154,11 @@ void BM_LineImplicit2(benchmark::State& s) { Line(s, "implicit2"); }
 BENCHMARK(BM_LineBdf2)->Arg(80)->Arg(100);
 BENCHMARK(BM_LineImplicit)->Arg(80)->Arg(100);
 BENCHMARK(BM_LineImplicit2)->Arg(100);
+
+void BM_RingWatchOn(benchmark::State& s) { Watch(s, true); }
+void BM_RingWatchOff(benchmark::State& s) { Watch(s, false); }
+BENCHMARK(BM_RingWatchOn)->Arg(10)->Arg(100)->Arg(400);
+BENCHMARK(BM_RingWatchOff)->Arg(10)->Arg(100)->Arg(400);
 
 void BM_StepImplicit(benchmark::State& s) { Step(s, "implicit", true); }
 void BM_StepBdf2(benchmark::State& s) { Step(s, "bdf2", true); }
