@@ -398,6 +398,9 @@ constexpr double kLeadFrom = 1;
 // six new failures). Not rk4: there it added failures (17 of 137 to 23 at 0.25-0.5, 17 of 90
 // to 18 at 0.5-0.8), the held force being fourth order in the tether and the consistent
 // coupling first order at the body.
+// Session 26 tried 0.4 (with kLeadFromImplicit2 0.3): 8 failures fixed and 2 new on the
+// tuned seeds 201-10000, but 1 fixed and 3 new on the held-out 10001-15000; not kept
+// (docs/coupling.md, session 26).
 constexpr double kLeadFromExplicit = 0.5;
 // implicit2 (session 10, s10i2: end node B takes SDIRK's velocity stages and the body's
 // position step, Sdirk2Step) from this omega h on: the scene fuzzer's implicit2 scenes failed
@@ -405,6 +408,7 @@ constexpr double kLeadFromExplicit = 0.5;
 // at 1-2, 26.4% -> 11.0% at 2-4, 8.8% at >= 4, refused before), but with it from 0.1 in 8.7% ->
 // 13.7% at 0.1-0.25 and 16.2% -> 14.7% at 0.25-0.5; the BlueROV2 at omega h 0.26 (EA 6e4) is
 // 1.5% off in tension with it, 0.58% without (docs/coupling.md, implicit2).
+// Session 26's 0.3: not kept, as kLeadFromExplicit's 0.4 above.
 constexpr double kLeadFromImplicit2 = 0.5;
 // Every integrator that has the consistent coupling also takes it where the end segment's
 // internal damping is stiff on the body's step, from h (damping/L0)/m_eff at this value on
