@@ -98,7 +98,7 @@ def main():
         classes[c] += 1
         detail = re.sub(r"Nan, Inf or huge value in QACC", "bad qacc", detail)
         detail = re.sub(r" The simulation is unstable\.", "", detail)
-        tag = f"{seed:<5}" + ("draw=1  " if draw == 1 else "")
+        tag = f"{seed:<5} " + ("draw=1  " if draw == 1 else "")
         lines[c].append(f"{tag}{c} omega*h={omega_h:.2g} {integ} (limit {LIMITS[integ]}), N={n}, "
                         f"EA={ea:.3g}, {mass:.3g} kg, seabed kind {sb}, thrust {thrust:.2f} EA: "
                         f"{kind}: {detail}"[:230])
