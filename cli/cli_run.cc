@@ -335,14 +335,12 @@ int Run(const RunOptions& opt) {
     // whether the step was the cause).
     if (status != kExitOk && status != kExitDiverged) cancel_fine = true;
   }
-  // Implicit steps that did not converge: once per run, at its end (README, Numerics).
-  for (const std::string& w : mjtether::StallWarnings(mm, d)) {
+  // Implicit steps that did not converge, snaps that rang: once per run, at its end (README,
+  // Numerics; docs/reference.md "Internal damping").
+  for (const std::string& w : mjtether::RunWarnings(mm, d)) {
     std::cerr << "mjtether: warning: " << w << "\n";
   }
-  const std::vector<std::string> rang = mjtether::RingWarnings(mm, d);
-  for (const std::string& w : rang) {
-    std::cerr << "mjtether: warning: " << w << "\n";
-  }
+  const bool rang = !mjtether::RingWarnings(mm, d).empty();  // for the step check's advice
   for (OutputFile* f : {&log, &nodes}) {
     if (!f->Commit(&error)) {
       std::cerr << "mjtether: " << error << "\n";
@@ -393,7 +391,7 @@ int Run(const RunOptions& opt) {
     }
     if (status <= kExitDiverged) {
       status = ReportCheck(opt, mm, d->time, recorder->trace(), fine_trace, bodies, status,
-                           fine_model->opt.timestep, !rang.empty());
+                           fine_model->opt.timestep, rang);
     }
   }
   return status;

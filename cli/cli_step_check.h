@@ -178,9 +178,7 @@ inline void RunFine(const mjModel* m, long long steps, const std::vector<int>& b
   }
   rec.Finish(m, d);
   *out = std::move(rec.trace());
-  for (std::vector<std::string> w : {StallWarnings(m, d), RingWarnings(m, d)}) {
-    out->warnings.insert(out->warnings.end(), w.begin(), w.end());
-  }
+  out->warnings = RunWarnings(m, d);
   mj_deleteData(d);
   done->store(true);
 }

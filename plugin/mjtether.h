@@ -191,6 +191,14 @@ std::vector<std::string> StallWarnings(const mjModel* m, const mjData* d, bool e
 // message per such tether, with the first snap's time, the largest jump and damping_ratio=1 as
 // the cure; empty otherwise. The CLI prints them at the end of a run.
 std::vector<std::string> RingWarnings(const mjModel* m, const mjData* d);
+// Everything a run says at its end about the steps it took: StallWarnings, then RingWarnings.
+// `mjtether run` prints these, the step check's fine run reports its own, and Python's
+// Simulation.run_warnings returns them.
+inline std::vector<std::string> RunWarnings(const mjModel* m, const mjData* d) {
+  std::vector<std::string> w = StallWarnings(m, d);
+  for (std::string& r : RingWarnings(m, d)) w.push_back(std::move(r));
+  return w;
+}
 // [-] The segment mode's damping ratio below which a snap's ringing is watched (RingWarnings,
 // `mjtether info`): below it the ringing keeps more than half its amplitude per cycle.
 inline constexpr double kRingDampingRatio = 0.1;

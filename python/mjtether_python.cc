@@ -456,13 +456,9 @@ PYBIND11_MODULE(mjtether, mod) {
                              "the time-step advisor's warnings, made at load")
       .def_property_readonly(
           "run_warnings",
-          [](Simulation& s) {
-            // What `mjtether run` prints at the end of a run, for the state so far (since load,
-            // reset, or the copy's source was): read them before trusting a result.
-            std::vector<std::string> w = mjtether::StallWarnings(s.m(), s.d());
-            for (std::string& r : mjtether::RingWarnings(s.m(), s.d())) w.push_back(std::move(r));
-            return w;
-          },
+          // What `mjtether run` prints at the end of a run, for the state so far (since load,
+          // reset, or the copy's source was): read them before trusting a result.
+          [](Simulation& s) { return mjtether::RunWarnings(s.m(), s.d()); },
           "warnings about the steps taken so far, as `mjtether run` prints at its end: implicit "
           "steps accepted unconverged (stalled) and snaps that rang the undamped segment mode "
           "(docs/python.md); empty when there is nothing to say")
