@@ -44,7 +44,9 @@
 //                an upper bound of the end's drag and damping); a coupling chatter (the
 //                run-time work balance) where omega h is at
 //                least half the advisor's limit; or, where the message blames the step, the
-//                same scene at a 10x smaller step runs to the end.
+//                same scene at a 10x smaller step runs to the end, or, where that fails and
+//                the message advises max_step (an explicit scheme at its automatic
+//                substeps), the scene with that max_step does.
 // Anything else is a failure: a refusal or divergence whose cause does not hold, a scene that
 // should have been refused, a non-finite value, a MuJoCo warning (it resets the data
 // silently), or a run that disagrees with its fine-step self.
@@ -1025,6 +1027,25 @@ Scene Damped(const Scene& s) {
   return c;
 }
 
+// The scene with `max_step=value` [s] declared on its tether (the advice of an explicit
+// scheme's divergence at its automatic substeps); an empty xml where the declaration is not
+// the fuzzer's.
+Scene WithMaxStep(const Scene& s, double value) {
+  Scene c = s;
+  const std::string tag = "<text name=\"tether:t\" data=\"";
+  const size_t begin = c.xml.find(tag);
+  const size_t end = begin == std::string::npos ? begin : c.xml.find('"', begin + tag.size());
+  if (end == std::string::npos) {
+    c.xml.clear();
+    return c;
+  }
+  std::ostringstream v;
+  v.precision(17);
+  v << " max_step=" << value;
+  c.xml.insert(end, v.str());
+  return c;
+}
+
 // The world scene with its obstacle moved on, the way MakeWorld moved it from the shape's
 // middle, until the initial shape's skin is clear of it by kClearedBy d: the twin of a scene
 // that starts inside the rock (Attach's "starts inside a geom it touches" warning), the rest
@@ -1431,6 +1452,20 @@ Outcome JudgeRuns(const Scene& s) {
     if (Contains(msg, "Reduce <option timestep>") || Contains(msg, "stable step")) {
       const Run fine = Simulate(s, kStep / 10, coarse.duration);
       const bool ok = !Failed(fine);
+      // An explicit scheme stopped at its automatic substeps advises max_step (a smaller MuJoCo
+      // step takes substeps of the same length; plugin.cc, session 26): where the 10x smaller
+      // step fails, the advised max_step must run.
+      const std::string key = "or max_step=";
+      if (const size_t at = msg.find(key); !ok && at != std::string::npos) {
+        const double value = std::atof(msg.c_str() + at + key.size());
+        const Scene cured = WithMaxStep(s, value);
+        if (value > 0 && !cured.xml.empty()) {
+          const Run c = Simulate(cured, kStep, coarse.duration);
+          const bool runs = !Failed(c);
+          return {"diverged: substep (the advised max_step runs)", runs,
+                  msg + (runs ? "" : " | with max_step=" + std::to_string(value) + ": " + Why(c))};
+        }
+      }
       return {"diverged: step (10x smaller step runs)", ok,
               msg + (ok ? "" : " | fine step: " + Why(fine))};
     }
