@@ -2605,7 +2605,9 @@ std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d) {
         // shape) can be high where the line bends sharply: fuzzer seed 12472, rk4 with EI
         // on a seabed touchdown of 90 degrees, runs from 0.62x of it (docs/scene_fuzzer.md).
         const double sub = m->opt.timestep / n;  // [s]
-        s << " (estimated at the straight line), and it took " << n << " substeps of " << sub
+        // DragSubsteps may have raised the count for a fast drag: "at least".
+        s << " (estimated at the straight line), and it took at least " << n << " substeps of "
+          << sub
           << " s per MuJoCo step (a smaller <option timestep> shortens them only once it is "
              "below that); use integrator=implicit, or fewer segments (now "
           << t.segments() << "), or max_step=" << 0.5 * sub

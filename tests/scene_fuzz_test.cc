@@ -1003,6 +1003,18 @@ Scene Throttled(const Scene& s) {
   return t;
 }
 
+// Where the tether's declaration `data="..."` of the fuzzer's scene sits in its xml: the
+// offsets of its first and one past its last character, or false where it is not there.
+bool TetherData(const std::string& xml, size_t* first, size_t* last) {
+  const std::string tag = "<text name=\"tether:t\" data=\"";
+  const size_t begin = xml.find(tag);
+  const size_t end = begin == std::string::npos ? begin : xml.find('"', begin + tag.size());
+  if (end == std::string::npos) return false;
+  *first = begin + tag.size();
+  *last = end;
+  return true;
+}
+
 // The scene with its tether's segment axial mode critically damped, damping_ratio=1 (what
 // RingWarnings advises; docs/reference.md "Internal damping"), the rest unchanged: the twin of
 // a scene in which a snap rang that mode undamped. An empty xml where the declaration's form is
@@ -1010,20 +1022,18 @@ Scene Throttled(const Scene& s) {
 Scene Damped(const Scene& s) {
   Scene c = s;
   c.damping = 1.0 * s.L0() * std::sqrt(s.EA * s.mpl);  // [N s] SegmentModeDamping at zeta 1
-  const std::string tag = "<text name=\"tether:t\" data=\"";
-  const size_t begin = c.xml.find(tag);
-  const size_t end = begin == std::string::npos ? begin : c.xml.find('"', begin + tag.size());
-  if (end == std::string::npos) {
+  size_t first, last;
+  if (!TetherData(c.xml, &first, &last)) {
     c.xml.clear();
     return c;
   }
-  std::string data = c.xml.substr(begin + tag.size(), end - begin - tag.size());
+  std::string data = c.xml.substr(first, last - first);
   if (const size_t at = data.find(" damping="); at != std::string::npos) {
     const size_t stop = data.find(' ', at + 1);
     data.erase(at, stop == std::string::npos ? std::string::npos : stop - at);
   }
   data += " damping_ratio=1";
-  c.xml.replace(begin + tag.size(), end - begin - tag.size(), data);
+  c.xml.replace(first, last - first, data);
   return c;
 }
 
@@ -1032,17 +1042,15 @@ Scene Damped(const Scene& s) {
 // the fuzzer's.
 Scene WithMaxStep(const Scene& s, double value) {
   Scene c = s;
-  const std::string tag = "<text name=\"tether:t\" data=\"";
-  const size_t begin = c.xml.find(tag);
-  const size_t end = begin == std::string::npos ? begin : c.xml.find('"', begin + tag.size());
-  if (end == std::string::npos) {
+  size_t first, last;
+  if (!TetherData(c.xml, &first, &last)) {
     c.xml.clear();
     return c;
   }
   std::ostringstream v;
   v.precision(17);
   v << " max_step=" << value;
-  c.xml.insert(end, v.str());
+  c.xml.insert(last, v.str());
   return c;
 }
 
