@@ -60,6 +60,15 @@ void TimeRestoring(benchmark::State& state, const mjModel* m, mjData* d, int per
   mj_deleteData(saved);
 }
 
+// Warms m up past its initial transient (500 steps), then times mj_step from that state,
+// restored every 1000 steps (TimeRestoring).
+void TimeWarmedSteps(benchmark::State& state, const mjModel* m, int segments) {
+  mjData* d = mj_makeData(m);
+  for (int k = 0; k < 500; ++k) mj_step(m, d);
+  TimeRestoring(state, m, d, 1000, segments, [&]() { mj_step(m, d); });
+  mj_deleteData(d);
+}
+
 void Step(benchmark::State& state, const char* integrator, bool tether) {
   const int segments = static_cast<int>(state.range(0));
   std::string error;
@@ -80,11 +89,7 @@ void Step(benchmark::State& state, const char* integrator, bool tether) {
     state.SkipWithError(error.c_str());
     return;
   }
-  mjData* d = mj_makeData(m);
-  // Warm up past the initial transient, then restore that state before each batch.
-  for (int k = 0; k < 500; ++k) mj_step(m, d);
-  TimeRestoring(state, m, d, 1000, segments, [&]() { mj_step(m, d); });
-  mj_deleteData(d);
+  TimeWarmedSteps(state, m, segments);
   mjtether::Detach(m);
   mj_deleteModel(m);
 }
@@ -107,10 +112,7 @@ void Watch(benchmark::State& state, bool watched) {
   if (mjtether::WatchesRinging(*mjtether::GetTether(m, 0), m->opt.timestep) != watched) {
     state.SkipWithError("the ringing watch is not what this benchmark assumes");
   } else {
-    mjData* d = mj_makeData(m);
-    for (int k = 0; k < 500; ++k) mj_step(m, d);
-    TimeRestoring(state, m, d, 1000, segments, [&]() { mj_step(m, d); });
-    mj_deleteData(d);
+    TimeWarmedSteps(state, m, segments);
   }
   mjtether::Detach(m);
   mj_deleteModel(m);
