@@ -443,15 +443,16 @@ int Info(const std::string& path, const std::vector<std::string>& set) {
                         "tensions depend on the step; damping_ratio=1 damps it)"
                       : "")
               << "\n";
-    // The whole line's lowest axial mode, ends held (the chain's omega_k = omega_n sin(k pi /
-    // 2N), k = 1), and its damping ratio c omega_1 / (2 EA) (Kelvin-Voigt damping is
-    // proportional to the stiffness: zeta_k = zeta_n omega_k / omega_n). damping_ratio damps
-    // the segment mode; this one keeps ringing after a start or a snap, and where it slackens
-    // the line the snap train it makes is chaotic (docs/reference.md "Internal damping").
-    const double w1 = t->SegmentModeFrequency() * std::sin(M_PI / (2.0 * t->segments()));
-    const double c = t->EndDamping() * t->rest_segment_length();  // [N s]
+    // The whole line's lowest axial mode, ends held: the chain's omega_k = omega_n sin(k pi /
+    // 2N), k = 1, and, Kelvin-Voigt damping being proportional to the stiffness, its damping
+    // ratio zeta_k = zeta_n sin(k pi / 2N) (= c omega_k / (2 EA)). damping_ratio damps the
+    // segment mode; this one keeps ringing after a start or a snap, and where it slackens the
+    // line the snap train it makes is chaotic (docs/reference.md "Internal damping").
+    const double lowest = std::sin(M_PI / (2.0 * t->segments()));  // [-] omega_1 / omega_n
+    const double w1 = t->SegmentModeFrequency() * lowest;          // [rad/s]
     std::cout << "    lowest axial mode (ends held): omega_1 " << w1 << " rad/s (period "
-              << 2 * M_PI / w1 << " s), damping ratio " << c * w1 / (2 * p.EA) << "\n";
+              << 2 * M_PI / w1 << " s), damping ratio " << t->SegmentModeRatio() * lowest
+              << "\n";
     const double cost = mjtether::EstimatedCostPerSecond(*t, m->opt.timestep);
     std::cout << "    estimated cost " << cost << " s of CPU per simulated second ("
               << (cost > 0 ? 1 / cost : 0) << "x real time)\n";

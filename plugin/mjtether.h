@@ -208,7 +208,7 @@ inline constexpr double kRingDampingRatio = 0.1;
 inline constexpr double kRingOmegaH = 0.05;
 // Whether a tether stepped over `timestep` [s] has its snaps watched for that ringing: an
 // implicit integrator, the segment mode's damping ratio below kRingDampingRatio and its
-// omega_n h above kRingOmegaH (h: the tether's own step). A winch tether is not watched either.
+// omega_n h above kRingOmegaH (h: the tether's own step), and no winch (its segments change).
 bool WatchesRinging(const Tether& t, double timestep);
 
 // Replaces MuJoCo's default error handler (which waits on stdin) by one that prints the

@@ -468,7 +468,8 @@ constexpr double kRingRelative = 0.02;  // [-] of the larger end tension, below 
 }  // namespace
 
 bool WatchesRinging(const Tether& t, double timestep) {
-  if (IsExplicit(t.params().integrator) || !(t.SegmentModeRatio() < kRingDampingRatio)) {
+  if (t.params().winch || IsExplicit(t.params().integrator) ||
+      !(t.SegmentModeRatio() < kRingDampingRatio)) {
     return false;
   }
   const int substeps = t.SubstepsFor(timestep);
@@ -479,7 +480,7 @@ namespace {
 void WatchSnaps(const AttachedTether& at, const double* x, const double* v, double dt,
                 double time, double* u) {
   const Tether& t = at.tether;
-  if (at.winch || !WatchesRinging(t, dt)) return;
+  if (!WatchesRinging(t, dt)) return;
   const double jump = t.SnapJump(x, v, dt);
   // A snap of kRingBigJump counts; a smaller one where it is kRingRelative of the ends' last
   // tensions (0.1 N on a 1 MN line does not).
