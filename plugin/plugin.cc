@@ -1948,19 +1948,18 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
         // 18 times (8 of 139 on seeds 201..15000, session 27), as often as the held force's
         // above, and one grew without a stop: held-out seed 14999 (7 substeps of the 2 ms
         // step, omega h 0.92, a 14 kg vehicle, Can 1) went from 10 N to 40 kN in 3 s and
-        // exited 0, where 1 ms (4 substeps) agrees with 0.2 ms. End node B's path over the
-        // substeps and the body's over one MuJoCo step part by O(h^2 a), and moving the node
-        // onto the site at each step put that energy into the line (docs/coupling.md, session
-        // 27). Not detected at run time: a check on that energy stopped 14999 only at 1.24 s
-        // and stopped two thrust scenes that agree (1372, 1723) at 0.1 s.
+        // exited 0, where 1 ms (4 substeps) agrees with 0.2 ms; Can=0 cures it too. The cause
+        // is not found (docs/coupling.md, session 27). Not detected at run time: a check on the
+        // energy that moving end node B onto the site puts into the line stopped 14999 only at
+        // 1.24 s, and stopped two thrust scenes that agree (1372, 1723) at 0.1 s.
         const int n = t.SubstepsFor(h);
         std::ostringstream w;
         w << where << head << "consistent coupling at coupling omega h = " << c.omega_h
           << " (omega = " << c.omega << " rad/s, <option timestep> " << h << " s, " << n
           << " tether substep(s)), at or above " << kCouplingAccurate
           << ", where the scene fuzzer finds 1 in 18 such runs off their 10x smaller step, "
-          << "and one whose end tension grew from 10 N to 40 kN in 3 s without a stop (end "
-          << "node B's path over the substeps and the body's over one step part); use "
+          << "and one whose end tension grew from 10 N to 40 kN in 3 s without a stop (the "
+          << "run-time checks do not see it); use "
           << "integrator=bdf2 (the default) or implicit (the end node is solved with the body "
           << "in one step), or <option timestep> <= " << kCouplingAccurate / c.omega << " s";
         set->warnings.push_back(w.str());
