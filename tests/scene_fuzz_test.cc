@@ -685,6 +685,7 @@ struct Run {
   std::string thrust_warning;   // Attach's warning of a thrust schedule beyond what it holds
   std::string contact_warning;  // Attach's warning of a start inside a geom it touches
   bool held_warning = false;    // Attach warned of a held end force at omega h >= 0.1
+  bool lead_warning = false;    // ... or of explicit's consistent coupling at omega h 0.1-1
   std::string ring_warning;     // RingWarnings at the end: a snap rang the undamped segment mode
   double duration = kDuration;  // [s] simulated
   double deployed = 0;  // [m] a winch's deployed unstretched length at the end (0: no winch)
@@ -781,6 +782,7 @@ Run Simulate(const Scene& s, double step, double duration = -1) {
     if (Contains(w, "the thrust: schedules push body")) run.thrust_warning = w;
     if (Contains(w, "starts inside a geom it touches")) run.contact_warning = w;
     if (Contains(w, "held end force at coupling omega h")) run.held_warning = true;
+    if (Contains(w, "consistent coupling at coupling omega h")) run.lead_warning = true;
   }
   mjData* d = mj_makeData(m);
   t_warnings = 0;
@@ -1450,9 +1452,20 @@ Outcome JudgeRuns(const Scene& s) {
               msg};
     }
     if (Contains(msg, "coupling chatter")) {
-      // The run-time work balance (docs/coupling.md): only where the advisor warned.
-      return {"diverged: coupling chatter",
-              CouplingLimitOf(s) > 0 && s.omega_h >= 0.5 * CouplingLimitOf(s), msg};
+      // The run-time work balance (docs/coupling.md): only where the advisor warned. From half
+      // the limit ("may chatter") as it stands; below it, where Attach warned of the held end
+      // force or of explicit's consistent coupling at omega h >= kCouplingAccurate (sessions 19
+      // and 27), the message's advice is checked too: the 10x smaller step (omega h below 0.1
+      // there, within the step it advises) runs to the end. Session 27: held-out seed 10311
+      // (explicit, the held force at omega h 0.42, warned at load) stopped so and failed.
+      const double limit = CouplingLimitOf(s);
+      if (limit > 0 && s.omega_h >= 0.5 * limit) return {"diverged: coupling chatter", true, msg};
+      const bool warned = limit > 0 && (coarse.held_warning || coarse.lead_warning);
+      const bool cured = warned && !Failed(Simulate(s, kStep / 10, coarse.duration));
+      return {"diverged: coupling chatter", cured,
+              msg + (warned ? (cured ? "; warned at load, and the 10x smaller step runs"
+                                     : "; warned at load, but the 10x smaller step fails too")
+                            : "; not warned at load")};
     }
     if (Contains(msg, "start-up strain")) {
       return {"diverged: stretched start", s.b.norm() > s.length, msg};
@@ -1889,6 +1902,25 @@ TEST(SceneFuzzOracle, EndWorkIsTheStepsForceAlongTheEndNodesDisplacement) {
   EXPECT_LE(coarse.excess, EnergyTolerance(coarse));
   const Outcome o = Judge(s);
   EXPECT_TRUE(o.pass) << o.kind << ": " << o.detail;
+  mju_user_warning = previous;
+}
+
+// A coupling chatter stop below half the advisor's limit (session 27): accepted where Attach
+// warned at load (the held end force, or explicit's consistent coupling, at omega h >= 0.1)
+// and the 10x smaller step runs to the end, as the message advises. Held-out seed 10311
+// (explicit, 35 segments, a 19 kg vehicle, the held force at omega h 0.42) stops at 0.39 s with
+// the chatter named; at 0.2 ms it runs. The same scene with bdf2 gets no such warning nor stop.
+TEST(SceneFuzzOracle, AChatterStopBelowHalfTheLimitPassesWhereItWasWarnedAndTheStepCuresIt) {
+  void (*previous)(const char*) = mju_user_warning;
+  mju_user_warning = CountWarning;
+  const Scene s = Make(10311, kDraw);
+  const mjtether::Run coarse = Simulate(s, kStep);
+  EXPECT_TRUE(coarse.held_warning);
+  EXPECT_LT(s.omega_h, 0.5 * CouplingLimitOf(s));
+  const Outcome o = Judge(s);
+  EXPECT_TRUE(o.pass) << o.kind << ": " << o.detail;
+  EXPECT_EQ(o.kind, "diverged: coupling chatter");
+  EXPECT_TRUE(Contains(o.detail, "warned at load, and the 10x smaller step runs")) << o.detail;
   mju_user_warning = previous;
 }
 
