@@ -1948,10 +1948,12 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
         // 18 times (8 of 139 on seeds 201..15000, session 27), as often as the held force's
         // above, and one grew without a stop: held-out seed 14999 (7 substeps of the 2 ms
         // step, omega h 0.92, a 14 kg vehicle, Can 1) went from 10 N to 40 kN in 3 s and
-        // exited 0, where 1 ms (4 substeps) agrees with 0.2 ms; Can=0 cures it too. The cause
-        // is not found (docs/coupling.md, session 27). Not detected at run time: a check on the
-        // energy that moving end node B onto the site puts into the line stopped 14999 only at
-        // 1.24 s, and stopped two thrust scenes that agree (1372, 1723) at 0.1 s.
+        // exited 0, where 1 ms (4 substeps) agrees with 0.2 ms; Can=0 cures it too. Leaving end
+        // node B where its substeps put it, instead of moving it onto the site each step, cures
+        // it too, but the offset drifts on taut lines and broke 6 other scenes (docs/coupling.md,
+        // session 27). Not detected at run time: a check on the energy that the move puts into
+        // the line stopped 14999 only at 1.24 s, and stopped two thrust scenes that agree (1372,
+        // 1723) at 0.1 s.
         const int n = t.SubstepsFor(h);
         std::ostringstream w;
         w << where << head << "consistent coupling at coupling omega h = " << c.omega_h
