@@ -1057,9 +1057,20 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
   const History hist = history ? History{history, history + 1, history + 1 + 3 * n}
                                : History{&h_prev, w.x0, w.v0};
   Ends now = from;
+  // explicit with a body at end B (the consistent coupling): end node B's position follows
+  // MuJoCo's Euler path for the body, x_B(t + s) = x_B(t) + s v_B(t + s), so that after the last
+  // substep it is where the body will be (x + dt v+, the velocity being the node's), and the
+  // plugin's move of the node onto the site at the next call is a_other's lag only. With the
+  // node's own path (x + sum h v_k) the two parted by dt (v_mean - v+) each step, and that move
+  // changed the end segment's stretch by energy no force did: held-out seed 14999 (7 substeps,
+  // coupling omega h 0.92, Can 1) grew from 10 N to 40 kN in 3 s (docs/coupling.md, session 27).
+  // With one substep this is symplectic Euler's own position step.
+  const bool euler_path = p_.integrator == Integrator::kExplicit && dynamic_b_ && from.body_b;
+  const Vec3 x_b0 = x.col(N_);
   for (int k = 0; k < steps; ++k) {
     const Ends next = k + 1 == steps ? to : Interpolate(from, to, dt, double(k + 1) / steps);
     Step(x, v, now, next, h, work, &status, &hist);
+    if (euler_path) x.col(N_) = x_b0 + ((k + 1) * h) * v.col(N_);
     // Work of the end forces over the step: the integrator's last force evaluation (explicit:
     // start of the step; implicit: the last Newton iterate; rk4: the last stage).
     const ConstNodes f(Work(work, N_).f, 3, n);

@@ -201,6 +201,12 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
   double* hv = history ? history + 1 + 3 * n : nullptr;
   Ends now = from;
   now.rest = p->rest;
+  // explicit with a body at end B: end node B along MuJoCo's Euler path, as in Advance
+  // without a winch (session 27).
+  const bool euler_path = p_.integrator == Integrator::kExplicit && dynamic_b_ && from.body_b;
+  Eigen::Map<Vec3> x_b(xp + 3 * N_);
+  const Eigen::Map<const Vec3> v_b(vp + 3 * N_);
+  const Vec3 x_b0 = x_b;
   for (int k = 0; k < steps; ++k) {
     Ends next = k + 1 == steps ? to : Interpolate(from, to, dt, double(k + 1) / steps);
     next.rest = now.rest + p->speed * h;
@@ -211,6 +217,7 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
     const History hist{hh, history ? hx + 3 * p->first : nullptr,
                        history ? hv + 3 * p->first : nullptr};
     view.Step(x, v, now, next, h, work, &status, history ? &hist : nullptr);
+    if (euler_path) x_b = x_b0 + ((k + 1) * h) * v_b;
     // Work of the end forces over the step, as Advance without a winch counts it (the
     // integrator's last force evaluation along the end's displacement): the coupling's work
     // balance reads it. Without it a winch tether's balance saw none of the tether's work and

@@ -23,6 +23,48 @@ namespace {
 
 using LightVehicle = testing::MuJoCoFixture;
 
+// explicit's consistent coupling (session 27): end node B, carrying a body, ends each advance
+// where MuJoCo's Euler step will put the body, x_B(t) + dt v_B(t + dt), whatever the substep
+// count, so that the plugin's move of the node onto the site at the next call changes nothing
+// but a_other's lag. With the node's own path over the substeps (x + sum h v_k) the two parted
+// by dt (v_mean - v+) each step, and the move pumped held-out seed 14999 from 10 N to 40 kN
+// (docs/coupling.md, session 27). Engine only: a dry 10 m line of 10 segments (EA 1e7 N,
+// 0.5 kg/m) stretched 1 cm between a fixed end A and a 20 kg body, one 2 ms advance. Tolerance:
+// rounding (with the node's own path the offset was 8.1e-4 m, the node having moved 1.7e-3 m).
+TEST(ExplicitConsistentCoupling, EndNodeBEndsTheAdvanceWhereMuJoCosEulerStepPutsTheBody) {
+  TetherParams p;
+  p.length = 10;
+  p.segments = 10;
+  p.diameter = 0.02;
+  p.mass_per_length = 0.5;
+  p.EA = 1e7;
+  p.effects = kAxial;
+  p.integrator = Integrator::kExplicit;
+  Environment env;
+  std::string error;
+  const std::optional<Tether> attached = Tether::Create(p, env, &error);
+  ASSERT_TRUE(attached) << error;
+  const Tether t = attached->WithDynamicEndB();
+  const double dt = 0.002;
+  ASSERT_GT(t.SubstepsFor(dt), 1);
+  EndInertia body;
+  body.mass = 20 * Eigen::Matrix3d::Identity();
+  Ends from;
+  from.b.pos = Vec3(10.01, 0, 0);
+  std::vector<double> x(3 * t.nodes()), v(3 * t.nodes()), work(t.WorkspaceSize());
+  t.InitialShape(from, x.data(), v.data());
+  Ends to = from;
+  to.time = dt;
+  from.body_b = to.body_b = &body;
+  const int N = t.segments();
+  const Vec3 start(x.data() + 3 * N);
+  ASSERT_TRUE(t.Advance(x.data(), v.data(), from, to, dt, work.data()).ok);
+  const Vec3 end(x.data() + 3 * N), velocity(v.data() + 3 * N);
+  std::printf("end node B moved %g m\n", (end - start).norm());
+  EXPECT_GT((end - start).norm(), 1e-4);  // the body moved
+  EXPECT_NEAR((end - (start + dt * velocity)).norm(), 0, 1e-12);
+}
+
 // The largest distance between the two runs' vehicles [m], and the largest relative difference
 // of their vehicle-end tensions from `from` [s] on, over the common samples.
 struct Agreement {
