@@ -1065,7 +1065,7 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
   // changed the end segment's stretch by energy no force did: held-out seed 14999 (7 substeps,
   // coupling omega h 0.92, Can 1) grew from 10 N to 40 kN in 3 s (docs/coupling.md, session 27).
   // With one substep this is symplectic Euler's own position step.
-  const bool euler_path = p_.integrator == Integrator::kExplicit && dynamic_b_ && from.body_b;
+  const bool euler_path = ExplicitWithBody(from);
   const Vec3 x_b0 = x.col(N_);
   for (int k = 0; k < steps; ++k) {
     const Ends next = k + 1 == steps ? to : Interpolate(from, to, dt, double(k + 1) / steps);
@@ -1077,7 +1077,7 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
     status.work_a += f.col(0).dot(next.a.pos - now.a.pos);
     // explicit with a body at end B (the consistent coupling): end A's impulse over the
     // substeps, each of which took the force at its start (plugin: end A's force is its mean).
-    if (p_.integrator == Integrator::kExplicit && dynamic_b_ && next.body_b) {
+    if (ExplicitWithBody(next)) {
       status.impulse_a += h * Vec3(f.col(0));
       status.has_impulse_a = true;
     }

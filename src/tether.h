@@ -388,6 +388,11 @@ class Tether {
   bool Dynamic(int i) const { return i > 0 && (i < N_ || p_.free_end || dynamic_b_); }
   // End node B is stepped (free, or a body's end in a WithDynamicEndB() tether).
   bool DynamicB() const { return p_.free_end || dynamic_b_; }
+  // explicit carrying a body at end B over an advance from `e` (the consistent coupling): its
+  // Advance puts end node B on MuJoCo's Euler path and sums end A's impulse over the substeps.
+  bool ExplicitWithBody(const Ends& e) const {
+    return p_.integrator == Integrator::kExplicit && dynamic_b_ && e.body_b;
+  }
 
   TetherParams p_;
   Environment env_;

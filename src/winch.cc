@@ -203,7 +203,7 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
   now.rest = p->rest;
   // explicit with a body at end B: end node B along MuJoCo's Euler path, as in Advance
   // without a winch (session 27).
-  const bool euler_path = p_.integrator == Integrator::kExplicit && dynamic_b_ && from.body_b;
+  const bool euler_path = ExplicitWithBody(from);
   Eigen::Map<Vec3> x_b(xp + 3 * N_);
   const Eigen::Map<const Vec3> v_b(vp + 3 * N_);
   const Vec3 x_b0 = x_b;
@@ -227,7 +227,7 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
     status.work_a += f.col(0).dot(next.a.pos - now.a.pos);
     // explicit with a body at end B (the consistent coupling): end A's impulse over the
     // substeps, as Advance without a winch sums it (the plugin reports its mean).
-    if (p_.integrator == Integrator::kExplicit && dynamic_b_ && next.body_b) {
+    if (ExplicitWithBody(next)) {
       status.impulse_a += h * Vec3(f.col(0));
       status.has_impulse_a = true;
     }

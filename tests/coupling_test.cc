@@ -358,6 +358,26 @@ bool WarnsHeldForce(const mjModel* m) {
   return false;
 }
 
+// The load warning names the step that brings the coupling to omega h kCouplingAccurate.
+void ExpectNamesTheAdvisedStep(const std::string& warning, const CouplingLimit& c) {
+  std::ostringstream named;
+  named << "<option timestep> <= " << kCouplingAccurate / c.omega << " s";
+  EXPECT_TRUE(Contains(warning, named.str())) << warning << " | " << named.str();
+}
+
+// Each run's mean vehicle-end tension over the last 0.2 s of 1 s agrees with the fine run's
+// within the scene fuzzer's tolerance, max(0.5 N, 5%), and no run stops.
+void ExpectEachAgreesWithTheFineRun(mjModel* fine, std::initializer_list<mjModel*> runs) {
+  std::string stopped;
+  const double ref = MeanEndTension(fine, 1.0, 0.2, &stopped);
+  ASSERT_EQ(stopped, "");
+  const double tol = std::max(0.5, 0.05 * ref);
+  for (mjModel* m : runs) {
+    EXPECT_NEAR(MeanEndTension(m, 1.0, 0.2, &stopped), ref, tol);
+    EXPECT_EQ(stopped, "");
+  }
+}
+
 TEST_F(Coupling, HeldForceWhereItIsOftenOffIsWarnedAndBothCuresHold) {
   mjModel* coarse = Load(Seed3244Xml("explicit", 0.001), "seed3244.xml");
   ASSERT_NE(coarse, nullptr);
@@ -375,9 +395,7 @@ TEST_F(Coupling, HeldForceWhereItIsOftenOffIsWarnedAndBothCuresHold) {
   const CouplingLimit c = GetCouplingLimit(coarse, 0, 1);
   EXPECT_FALSE(c.consistent);
   const double advised = kCouplingAccurate / c.omega;
-  std::ostringstream named;
-  named << "<option timestep> <= " << advised << " s";
-  EXPECT_TRUE(Contains(held, named.str())) << held << " | " << named.str();
+  ExpectNamesTheAdvisedStep(held, c);
 
   mjModel* fine = Load(Seed3244Xml("explicit", 1e-4), "seed3244_fine.xml");
   mjModel* bdf2 = Load(Seed3244Xml("bdf2", 0.001), "seed3244_bdf2.xml");
@@ -388,14 +406,7 @@ TEST_F(Coupling, HeldForceWhereItIsOftenOffIsWarnedAndBothCuresHold) {
   EXPECT_FALSE(WarnsHeldForce(fine));
   EXPECT_FALSE(WarnsHeldForce(bdf2));
   EXPECT_FALSE(WarnsHeldForce(cured));
-  std::string stopped;
-  const double ref = MeanEndTension(fine, 1.0, 0.2, &stopped);
-  ASSERT_EQ(stopped, "");
-  const double tol = std::max(0.5, 0.05 * ref);
-  EXPECT_NEAR(MeanEndTension(bdf2, 1.0, 0.2, &stopped), ref, tol);
-  EXPECT_EQ(stopped, "");
-  EXPECT_NEAR(MeanEndTension(cured, 1.0, 0.2, &stopped), ref, tol);
-  EXPECT_EQ(stopped, "");
+  ExpectEachAgreesWithTheFineRun(fine, {bdf2, cured});
 }
 
 // Scene fuzzer held-out seed 14999 (session 27): a 14 kg vehicle on 6 explicit segments of EA
@@ -456,9 +467,7 @@ TEST_F(Coupling, ExplicitsConsistentCouplingAgreesAtSevenSubstepsAndIsWarnedBelo
   EXPECT_TRUE(Contains(lead, "7 tether substep(s)")) << lead;
   EXPECT_TRUE(Contains(lead, "use integrator=bdf2 (the default) or implicit")) << lead;
   const double advised = kCouplingAccurate / c.omega;
-  std::ostringstream named;
-  named << "<option timestep> <= " << advised << " s";
-  EXPECT_TRUE(Contains(lead, named.str())) << lead << " | " << named.str();
+  ExpectNamesTheAdvisedStep(lead, c);
 
   mjModel* fine = Load(Seed14999Xml("explicit", 2e-4), "seed14999_fine.xml");
   mjModel* bdf2 = Load(Seed14999Xml("bdf2", 0.002), "seed14999_bdf2.xml");
@@ -469,16 +478,7 @@ TEST_F(Coupling, ExplicitsConsistentCouplingAgreesAtSevenSubstepsAndIsWarnedBelo
   EXPECT_EQ(LeadWarning(fine), "");  // the held force there (omega h 0.09)
   EXPECT_EQ(LeadWarning(bdf2), "");
   EXPECT_EQ(LeadWarning(cured), "");
-  std::string stopped;
-  const double ref = MeanEndTension(fine, 1.0, 0.2, &stopped);
-  ASSERT_EQ(stopped, "");
-  const double tol = std::max(0.5, 0.05 * ref);
-  EXPECT_NEAR(MeanEndTension(coarse, 1.0, 0.2, &stopped), ref, tol);
-  EXPECT_EQ(stopped, "");
-  EXPECT_NEAR(MeanEndTension(bdf2, 1.0, 0.2, &stopped), ref, tol);
-  EXPECT_EQ(stopped, "");
-  EXPECT_NEAR(MeanEndTension(cured, 1.0, 0.2, &stopped), ref, tol);
-  EXPECT_EQ(stopped, "");
+  ExpectEachAgreesWithTheFineRun(fine, {coarse, bdf2, cured});
   // The vehicle at 3 s (the growth took it 0.25 m off): within 5 cm of the 0.2 ms run's.
   const int body = mj_name2id(coarse, mjOBJ_BODY, "rov");
   Eigen::Vector3d at[2];
