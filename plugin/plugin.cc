@@ -1940,11 +1940,14 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
       const std::string head = std::string("integrator=") + IntegratorName(p.integrator) +
                                " with end " + (end == 0 ? "A" : "B") + " on body '" +
                                (body ? body : "?") + "': ";
-      // The refusal advises the largest step that loads (limit / omega); the chatter warning
-      // above half the limit advises kCouplingAccurate / omega, as the warnings below it and
-      // the chatter stop do: the step at the limit was often the very step that warned
-      // (session 28: rk4 seed 913 at omega h 0.71 was told "<= 0.00226 s" at 0.002 s).
+      // The refusal and the chatter warning above half the limit advise kCouplingAccurate /
+      // omega, as the warnings below it and the chatter stop do; the refusal also gives the
+      // limit's step. Until session 28 both advised limit / omega, the largest step that loads:
+      // a refused user who took it landed in the warned band, and the warning's step was often
+      // the very step that warned (rk4 seed 913 at omega h 0.71 was told "<= 0.00226 s" at
+      // 0.002 s, and grew from 11 N to 47 kN in 3 s).
       const bool refused = c.omega_h >= c.limit;
+      const double advised = StepAtMost(kCouplingAccurate / c.omega);  // [s]
       std::ostringstream s;
       s << head << "coupling omega h = " << c.omega_h
         << " (omega = sqrt(k_end/m_eff) = sqrt(" << c.k_end << " N/m / " << c.m_eff
@@ -1956,8 +1959,9 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
                 : "; use integrator=implicit or bdf2 (stable at any omega h measured) or "
                   "implicit2 (not limited on a free body at end B with end A fixed, up to "
                   "omega h 1 elsewhere), or <option ")
-        << "timestep> <= " << StepAtMost((refused ? c.limit : kCouplingAccurate) / c.omega)
-        << " s, or fewer segments or a smaller EA";
+        << "timestep> <= " << advised << " s (omega h " << kCouplingAccurate;
+      if (refused) s << "; the limit is at " << c.limit / c.omega << " s";
+      s << "), or fewer segments or a smaller EA";
       if (refused) {
         *error = where + s.str();
         ok = false;

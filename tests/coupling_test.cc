@@ -191,10 +191,11 @@ double AdvisedStep(const std::string& message) {
   return at == std::string::npos ? 0 : std::atof(message.c_str() + at + key.size());
 }
 
-// The chatter warning above half the limit advises a step that leaves every coupling warning
-// behind: kCouplingAccurate / omega. Until session 28 it advised limit / omega, the largest step
-// that loads, which was above the step that warned (rk4 seed 913 at omega h 0.71 was told
-// "<= 0.00226 s" at 0.002 s and grew from 11 N to 47 kN in 3 s). The BlueROV2 at EA 1e6 with
+// The chatter warning above half the limit, and the refusal at it, advise a step that leaves
+// every coupling warning behind: kCouplingAccurate / omega. Until session 28 they advised
+// limit / omega, the largest step that loads, which for the warning was above the step that
+// warned (rk4 seed 913 at omega h 0.71 was told "<= 0.00226 s" at 0.002 s and grew from 11 N to
+// 47 kN in 3 s). The BlueROV2 at EA 1e6 with
 // explicit (omega h 1.06 of 2, the consistent coupling) and at EA 3e5 with rk4 (0.58 of 0.8,
 // the held force): each warns with the measured rate, and at the advised step loads silent.
 TEST_F(Coupling, TheChatterWarningAdvisesAStepThatLeavesTheWarnedBand) {
@@ -218,6 +219,19 @@ TEST_F(Coupling, TheChatterWarningAdvisesAStepThatLeavesTheWarnedBand) {
     EXPECT_LT(GetCouplingLimit(followed, 0, 1).omega_h, kCouplingAccurate);
     EXPECT_TRUE(Warnings(followed).empty()) << Warnings(followed)[0];
   }
+  // The refusal advises the same step (it advised the limit's, which loads into the warned
+  // band) and still names the limit: rk4 at EA 1e6, omega h 1.06 of 0.8.
+  std::string error;
+  mjModel* refused = LoadModelFromString(BlueRovXml("1e6", "rk4", 0.002), "refused.xml", &error);
+  EXPECT_EQ(refused, nullptr);
+  if (refused) models_.push_back(refused);
+  EXPECT_TRUE(Contains(error, "limit 0.8")) << error;
+  EXPECT_TRUE(Contains(error, "; the limit is at ")) << error;
+  const double advised = AdvisedStep(error);
+  ASSERT_GT(advised, 0) << error;
+  mjModel* followed = Load(BlueRovXml("1e6", "rk4", advised), "refused_followed.xml");
+  ASSERT_NE(followed, nullptr);
+  EXPECT_TRUE(Warnings(followed).empty()) << Warnings(followed)[0];
 }
 
 // Chatter at run time: a scene loaded at a step the advisor accepts (0.25 ms: omega h = 0.42,
