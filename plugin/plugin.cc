@@ -1952,7 +1952,10 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
       s << head << "coupling omega h = " << c.omega_h
         << " (omega = sqrt(k_end/m_eff) = sqrt(" << c.k_end << " N/m / " << c.m_eff
         << " kg) = " << c.omega << " rad/s, <option timestep> " << h << " s), limit " << c.limit;
-      if (!refused) s << " (above half the limit: may chatter" << ChatterRate(p.integrator, c.consistent) << ")";
+      if (!refused) {
+        s << " (above half the limit: may chatter" << ChatterRate(p.integrator, c.consistent)
+          << ")";
+      }
       s << (p.integrator == Integrator::kImplicit2
                 ? "; use integrator=bdf2 (the default) or implicit (measured within 1% at "
                   "omega h 10.6), or <option "

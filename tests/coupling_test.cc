@@ -195,9 +195,9 @@ double AdvisedStep(const std::string& message) {
 // every coupling warning behind: kCouplingAccurate / omega. Until session 28 they advised
 // limit / omega, the largest step that loads, which for the warning was above the step that
 // warned (rk4 seed 913 at omega h 0.71 was told "<= 0.00226 s" at 0.002 s and grew from 11 N to
-// 47 kN in 3 s). The BlueROV2 at EA 1e6 with
-// explicit (omega h 1.06 of 2, the consistent coupling) and at EA 3e5 with rk4 (0.58 of 0.8,
-// the held force): each warns with the measured rate, and at the advised step loads silent.
+// 47 kN in 3 s). The BlueROV2 at EA 1e6 with explicit (omega h 1.06 of 2, the consistent
+// coupling) and at EA 3e5 with rk4 (0.58 of 0.8, the held force): each warns with the measured
+// rate, and at the advised step loads silent.
 TEST_F(Coupling, TheChatterWarningAdvisesAStepThatLeavesTheWarnedBand) {
   for (const auto& [EA, integrator] : {std::pair<std::string, std::string>{"1e6", "explicit"},
                                        {"3e5", "rk4"}}) {
