@@ -1035,6 +1035,16 @@ const double* UserBlock(const mjModel* m, const mjData* d, int k) {
   return d->userdata + set->tethers[k].offset;
 }
 
+// A step to advise as "<= x" or "below x": x rounded down to three significant digits, so that
+// the printed figure, taken literally, is within the bound (printed at six digits, 0.1 / omega
+// for the BlueROV2 at EA 3e5 read 0.000344 s, omega h 0.100025, and the scene at that step still
+// warned; session 28). Every advised step and max_step goes through it.
+double StepAtMost(double x) {
+  if (!(x > 0) || !std::isfinite(x)) return x;
+  const double unit = std::pow(10.0, std::floor(std::log10(x)) - 2);
+  return std::floor(x / unit) * unit;
+}
+
 // Time-step advisor for an explicit tether, from its stability limit (Tether::ExplicitStableStep,
 // highest natural frequency of the axial, bending and seabed stiffness on the lightest node).
 // A tether step fixed by `substeps` or `max_step` above the limit gets a warning naming the
@@ -1067,7 +1077,7 @@ bool Advise(const Tether& t, double timestep, std::string* warning, std::string*
               ? "; beyond it a slack tether gains energy at every slack-taut switch"
               : "")
       << "); set substeps >= " << static_cast<long long>(std::ceil(timestep / limit))
-      << " or max_step <= " << limit
+      << " or max_step <= " << StepAtMost(limit)
       << ", or remove both (automatic substeps), or use integrator=implicit";
     *warning = s.str();
     return true;
@@ -1693,7 +1703,7 @@ std::string Diagnose(const mjModel* m, const mjData* d, const Environment& env,
         << " s, more than half of max_strain x the segment length "
         << p.max_strain * t.rest_segment_length()
         << " m: that motion is too fast for the step; reduce <option timestep> below "
-        << 0.5 * p.max_strain * t.rest_segment_length() / vel[end].norm()
+        << StepAtMost(0.5 * p.max_strain * t.rest_segment_length() / vel[end].norm())
         << " s or slow the motion";
       return s.str();
     }
@@ -1786,16 +1796,6 @@ void WarnThrustBeyondHolds(const mjModel* m, ModelTethers* set) {
     }
   }
   if (scratch) mj_deleteData(scratch);
-}
-
-// A step to advise as "<= x": x rounded down to three significant digits, so that the printed
-// figure, taken literally, is within the bound (printed at six digits, 0.1 / omega for the
-// BlueROV2 at EA 3e5 read 0.000344 s, omega h 0.100025, and the scene at that step still
-// warned; session 28).
-double StepAtMost(double x) {
-  if (!(x > 0) || !std::isfinite(x)) return x;
-  const double unit = std::pow(10.0, std::floor(std::log10(x)) - 2);
-  return std::floor(x / unit) * unit;
 }
 
 // What the scene fuzzer measured above half the coupling limit (seeds 201..15000 on session 27's
@@ -2626,7 +2626,7 @@ std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d) {
         text.pop_back();  // the space after the cause's full stop
         return text;
       }
-      s << "Reduce <option timestep> below " << m->opt.timestep * limit / rate
+      s << "Reduce <option timestep> below " << StepAtMost(m->opt.timestep * limit / rate)
         << " s, or reduce what drives the body that fast (thrust, motion), or make the body "
            "heavier.";
       return s.str();
