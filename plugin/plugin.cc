@@ -1947,7 +1947,7 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
       // the very step that warned (rk4 seed 913 at omega h 0.71 was told "<= 0.00226 s" at
       // 0.002 s, and grew from 11 N to 47 kN in 3 s).
       const bool refused = c.omega_h >= c.limit;
-      const double advised = StepAtMost(kCouplingAccurate / c.omega);  // [s]
+      const double advised = StepAtMost(kCouplingAccurate / c.omega);  // [s] every warning's
       std::ostringstream s;
       s << head << "coupling omega h = " << c.omega_h
         << " (omega = sqrt(k_end/m_eff) = sqrt(" << c.k_end << " N/m / " << c.m_eff
@@ -1981,7 +1981,7 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
           << ", where the scene fuzzer finds 1 in 20 such runs off their 10x smaller step "
           << "(an end-force chatter can grow without a stop); use integrator=bdf2 (the "
           << "default) or implicit (the end node is solved with the body), or <option "
-          << "timestep> <= " << StepAtMost(kCouplingAccurate / c.omega) << " s";
+          << "timestep> <= " << advised << " s";
         set->warnings.push_back(w.str());
       } else if (c.consistent && p.integrator == Integrator::kExplicit &&
                  c.omega_h >= kCouplingAccurate) {
@@ -2000,8 +2000,7 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
           << ", where the scene fuzzer finds 1 in 30 such runs off their 10x smaller step "
           << "(the run-time checks do not see it); use "
           << "integrator=bdf2 (the default) or implicit (the end node is solved with the body "
-          << "in one step), or <option timestep> <= " << StepAtMost(kCouplingAccurate / c.omega)
-          << " s";
+          << "in one step), or <option timestep> <= " << advised << " s";
         set->warnings.push_back(w.str());
       }
     }
@@ -2571,9 +2570,10 @@ std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d) {
         << m->opt.timestep << " s. ";
       // (Checked for explicit and rk4 tethers only, which are refused at load at omega h >=
       // c.limit: a chatter is below that stability limit.) The step advised is the one that
-      // brings omega h to 0.25, below which the scene fuzzer's long run finds the held end
-      // force as accurate as the other integrators' (docs/scene_fuzzer.md, "Where the failures
-      // are"), and never more than half the step that chattered.
+      // brings omega h to kCouplingAccurate (0.1; 0.25 until session 19, the very step at
+      // which seed 3244 rang), below which the scene fuzzer finds the held end force about as
+      // accurate as the other integrators (docs/coupling.md, session 19), and never more than
+      // half the step that chattered.
       // (omega h is that of the step now: c.omega_h is the one checked at load, and a caller
       // may have changed <option timestep> since.)
       const double advised = std::min(kCouplingAccurate / c.omega, 0.5 * m->opt.timestep);
