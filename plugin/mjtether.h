@@ -98,8 +98,16 @@ StaticResult GetStaticStart(const mjModel* m, int k);
 // (the coupling added failures on the fuzzer's rk4 scenes below 0.8). Neither limit is lowered:
 // the fuzzer's long run fails 21% (explicit) and 20% (rk4) of its scenes at omega h 0.1-0.25,
 // as many as at 0.5-2 (explicit 14-17% with the coupling, rk4 19% at 0.5-0.8).
+// rk4: 0.8 until session 29, lowered to 0.5. By session 28 the fuzzer's rates had fallen
+// below 1.2% at omega h < 0.25 for rk4, and its band 0.5-0.8 had become the worst of any
+// integrator: 5 of 61 runs off their 10x smaller step on the tuned seeds 201-10000 and 2 of
+// 24 on the held-out 10001-15000 (8.2% on both), against 6 of 138 at 0.25-0.5 and 2 of 225 at
+// 0.1-0.25; one of them (913, 0.71) grew from 11 N to 47 kN in 3 s with exit 0. The yanked
+// body above does not show it (0.3-1.3% of the work at 0.5-0.79, not monotone; 8% at 0.92):
+// the limit is the fuzzer's, measured on seeds it was not chosen on, and a refusal cannot turn
+// a correct run wrong (docs/coupling.md, session 29).
 constexpr double kCouplingLimitExplicit = 2.0;
-constexpr double kCouplingLimitRk4 = 0.8;
+constexpr double kCouplingLimitRk4 = 0.5;
 // implicit2 with the held force (after the semismooth Newton of issue 11 item 4): within 1% at
 // omega h = 3.36, 3.4% off in position at 10.6 on the same case; refused from 1 where the
 // consistent coupling does not apply (end A on a body that moves, a winch (for implicit2; explicit

@@ -37,14 +37,6 @@ TEST_P(CouplingCases, AgreeWithTheFineStepOrAreRefusedAtLoad) {
   const auto [EA, integrator] = GetParam();
   InstallErrorHandlers();
   std::string error;
-  mjModel* fine = LoadModelFromString(BlueRovXml(EA, integrator, 1e-4), "fine.xml", &error);
-  ASSERT_NE(fine, nullptr) << error;
-  std::string stopped;
-  const std::vector<Sample> ref = RunScene(fine, 1.5, &stopped);
-  Detach(fine);
-  mj_deleteModel(fine);
-  ASSERT_EQ(stopped, "") << "the 0.1 ms reference must run";
-
   mjModel* m = LoadModelFromString(BlueRovXml(EA, integrator, 0.002), "case.xml", &error);
   if (!m) {
     // Refused: only the explicit schemes, above the coupling limit, naming it and the fix.
@@ -54,7 +46,7 @@ TEST_P(CouplingCases, AgreeWithTheFineStepOrAreRefusedAtLoad) {
     EXPECT_TRUE(Contains(error, "case.xml: <text name=\"tether:umbilical\">")) << error;
     EXPECT_TRUE(Contains(error, "omega h = ")) << error;
     const std::string name = integrator;
-    EXPECT_TRUE(Contains(error, name == "rk4"         ? "limit 0.8"
+    EXPECT_TRUE(Contains(error, name == "rk4"         ? "limit 0.5"
                                 : name == "implicit2" ? "limit 1"
                                                       : "limit 2"))
         << error;
@@ -63,6 +55,16 @@ TEST_P(CouplingCases, AgreeWithTheFineStepOrAreRefusedAtLoad) {
     std::printf("EA %s %s: refused at load\n", EA, integrator);
     return;
   }
+  // The 0.1 ms reference, only for a case that loads (rk4 at EA 1e8 is refused at 0.1 ms too:
+  // omega h 0.53 against its limit 0.5).
+  mjModel* fine = LoadModelFromString(BlueRovXml(EA, integrator, 1e-4), "fine.xml", &error);
+  ASSERT_NE(fine, nullptr) << error;
+  std::string stopped;
+  const std::vector<Sample> ref = RunScene(fine, 1.5, &stopped);
+  Detach(fine);
+  mj_deleteModel(fine);
+  ASSERT_EQ(stopped, "") << "the 0.1 ms reference must run";
+
   const std::vector<Sample> got = RunScene(m, 1.5, &stopped);
   Detach(m);
   mj_deleteModel(m);
@@ -196,11 +198,12 @@ double AdvisedStep(const std::string& message) {
 // limit / omega, the largest step that loads, which for the warning was above the step that
 // warned (rk4 seed 913 at omega h 0.71 was told "<= 0.00226 s" at 0.002 s and grew from 11 N to
 // 47 kN in 3 s). The BlueROV2 at EA 1e6 with explicit (omega h 1.06 of 2, the consistent
-// coupling) and at EA 3e5 with rk4 (0.58 of 0.8, the held force): each warns with the measured
-// rate, and at the advised step loads silent.
+// coupling) and at EA 1.5e5 with rk4 (0.41 of 0.5, the held force; 0.58 at EA 3e5 until session
+// 29 lowered rk4's limit from 0.8): each warns with the measured rate, and at the advised step
+// loads silent.
 TEST_F(Coupling, TheChatterWarningAdvisesAStepThatLeavesTheWarnedBand) {
   for (const auto& [EA, integrator] : {std::pair<std::string, std::string>{"1e6", "explicit"},
-                                       {"3e5", "rk4"}}) {
+                                       {"1.5e5", "rk4"}}) {
     SCOPED_TRACE(integrator);
     mjModel* m = Load(BlueRovXml(EA, integrator, 0.002), integrator + ".xml");
     ASSERT_NE(m, nullptr);
@@ -220,18 +223,38 @@ TEST_F(Coupling, TheChatterWarningAdvisesAStepThatLeavesTheWarnedBand) {
     EXPECT_TRUE(Warnings(followed).empty()) << Warnings(followed)[0];
   }
   // The refusal advises the same step (it advised the limit's, which loads into the warned
-  // band) and still names the limit: rk4 at EA 1e6, omega h 1.06 of 0.8.
+  // band) and still names the limit: rk4 at EA 1e6, omega h 1.06 of 0.5.
   std::string error;
   mjModel* refused = LoadModelFromString(BlueRovXml("1e6", "rk4", 0.002), "refused.xml", &error);
   EXPECT_EQ(refused, nullptr);
   if (refused) models_.push_back(refused);
-  EXPECT_TRUE(Contains(error, "limit 0.8")) << error;
+  EXPECT_TRUE(Contains(error, "limit 0.5")) << error;
   EXPECT_TRUE(Contains(error, "; the limit is at ")) << error;
   const double advised = AdvisedStep(error);
   ASSERT_GT(advised, 0) << error;
   mjModel* followed = Load(BlueRovXml("1e6", "rk4", advised), "refused_followed.xml");
   ASSERT_NE(followed, nullptr);
   EXPECT_TRUE(Warnings(followed).empty()) << Warnings(followed)[0];
+}
+
+// rk4 is refused from coupling omega h 0.5 (0.8 until session 29): the scene fuzzer's rk4 runs
+// at 0.5-0.8 were off their 10x smaller step in 7 of 85 (8.2% on the tuned seeds and on the
+// held-out ones alike; seed 913 grew from 11 N to 47 kN in 3 s with exit 0), against 6 of 138
+// at 0.25-0.5. The BlueROV2 at EA 3e5 (omega h 0.58) is refused, naming the limit and the cures;
+// at EA 1.5e5 (0.41) it loads, warned.
+TEST_F(Coupling, Rk4IsRefusedWhereTheFuzzerFindsItsWorstBand) {
+  std::string error;
+  mjModel* refused = LoadModelFromString(BlueRovXml("3e5", "rk4", 0.002), "rk4.xml", &error);
+  EXPECT_EQ(refused, nullptr);
+  if (refused) models_.push_back(refused);
+  EXPECT_TRUE(Contains(error, "rk4.xml: <text name=\"tether:umbilical\">: integrator=rk4"))
+      << error;
+  EXPECT_TRUE(Contains(error, "limit 0.5; use integrator=implicit or bdf2")) << error;
+  mjModel* m = Load(BlueRovXml("1.5e5", "rk4", 0.002), "rk4_below.xml");
+  ASSERT_NE(m, nullptr);
+  const CouplingLimit c = GetCouplingLimit(m, 0, 1);
+  EXPECT_NEAR(c.omega_h, 0.41, 0.01);
+  EXPECT_EQ(c.limit, 0.5);
 }
 
 // Chatter at run time: a scene loaded at a step the advisor accepts (0.25 ms: omega h = 0.42,

@@ -16,7 +16,7 @@ constexpr double kPi = 3.14159265358979323846;
 
 // ---------------------------------------------------------------------------------------------
 // Wrap: a pile (radius R = 0.3 m, 20 m tall, on the world body) stands at the origin.
-// End A is a 20 kg slider (damped, 250 N s/m: the slider-tether spring would ring otherwise) on the
+// End A is a 40 kg slider (damped, 250 N s/m: the slider-tether spring would ring otherwise) on the
 // x axis at x = -8 m, pulled away from the pile by F_A = 20 N; end B is a mocap vehicle that orbits
 // the pile clockwise at radius 1.5 m, two turns in 16 s (after a 1 s ramp). The tether (weightless:
 // no gravity, no water) winds onto the pile. The vehicle's leg keeps its length, so each radian of
@@ -65,7 +65,7 @@ TEST_P(Wrap, TwoTurnsAndCapstanAlongTheWrap) {
     <body name="slider" pos=")" +
                           Fmt(A0.x()) + R"( 0 0">
       <joint name="x" type="slide" axis="1 0 0" damping="250"/>
-      <geom type="sphere" size="0.02" mass="20" contype="0" conaffinity="0"/>
+      <geom type="sphere" size="0.02" mass="40" contype="0" conaffinity="0"/>
       <site name="a"/>
     </body>
     <body name="vehicle" mocap="true" pos=")" +
