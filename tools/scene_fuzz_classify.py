@@ -4,6 +4,9 @@
   MJTETHER_SCENE_FUZZ_VERBOSE=1 build/tests/scene_fuzz_test > fuzz.log
   python3 tools/scene_fuzz_classify.py fuzz.log            # known-list lines, by class
   python3 tools/scene_fuzz_classify.py --counts fuzz.log   # outcome and class counts
+  python3 tools/scene_fuzz_classify.py --bands [--seeds A-B] fuzz.log
+      # per integrator and coupling omega h band: runs that went to their end, how many of
+      # them failed, refused, diverged with a checked cause (docs/coupling.md, session 29)
 
 Outcomes are counted as the test printed them, with one exception: a log from before session
 11 (s11trans) printed a stretched start that disagreed, but whose same scene started
@@ -38,8 +41,8 @@ LINE = re.compile(r"^seed (\d+)( draw=(\d+))? \[(\w+), N=(\d+), EA=([^,]+), m=([
                   r"([^:]+): ?(.*)$")
 # The advisor's refusal limit on a free vehicle at end B with end A fixed (the fuzzer's scenes):
 # implicit2 has none there since session 10 (its consistent coupling from omega h 0.5), explicit
-# keeps 2 with its consistent coupling from 0.5 (docs/coupling.md).
-LIMITS = {"explicit": "2", "rk4": "0.8", "implicit2": "none", "implicit": "none", "bdf2": "none"}
+# keeps 2 with its consistent coupling from 0.5, rk4 0.5 since session 29 (docs/coupling.md).
+LIMITS = {"explicit": "2", "rk4": "0.5", "implicit2": "none", "implicit": "none", "bdf2": "none"}
 CLASSES = ["coupling", "open-energy", "open-one-two-segments", "open-thrust-qacc",
            "open-stretched-start", "open-transient", "open-other"]
 
@@ -70,18 +73,58 @@ def classify(integ, n, omega_h, thrust, kind, detail=""):
     return "open-other"
 
 
+BANDS = [0, 0.1, 0.25, 0.5, 1, 2, 5, float("inf")]
+
+
+def print_bands(seen):
+    """Rates by integrator and omega h band, as the refusal limits and warnings quote them."""
+    table = {}
+    for (seed, draw), m in seen.items():
+        integ, omega_h = m.group(4), float(m.group(8))
+        passed, kind = m.group(11) == "pass", m.group(12)
+        band = max(i for i in range(len(BANDS) - 1) if omega_h >= BANDS[i])
+        if passed and kind.startswith("refused"):
+            cat = "refused"
+        elif passed and kind.startswith("diverged"):
+            cat = "diverged"
+        else:
+            cat = "ran" if passed else "failed"
+        table.setdefault((integ, band), Counter())[cat] += 1
+    print("integrator  omega h     ran  failed           refused  diverged")
+    for integ in LIMITS:
+        for band in range(len(BANDS) - 1):
+            c = table.get((integ, band))
+            if not c:
+                continue
+            ran = c["ran"] + c["failed"]
+            share = f"({100 * c['failed'] / ran:4.1f}%)" if ran else ""
+            label = f"{BANDS[band]:g}-{BANDS[band + 1]:g}"
+            print(f"{integ:10s}  {label:10s}  {ran:4d}  {c['failed']:4d} {share:9s}  "
+                  f"{c['refused']:7d}  {c['diverged']:8d}")
+
+
 def main():
     counts_only = "--counts" in sys.argv
-    path = [a for a in sys.argv[1:] if not a.startswith("--")][0]
+    bands = "--bands" in sys.argv
+    lo, hi = 0, float("inf")
+    args = sys.argv[1:]
+    if "--seeds" in args:
+        i = args.index("--seeds")
+        lo, hi = (int(x) for x in args[i + 1].split("-"))
+        del args[i:i + 2]
+    path = [a for a in args if not a.startswith("--")][0]
     seen = OrderedDict()
     for raw in open(path):
         m = LINE.match(raw.strip())
         if not m:
             continue
         seed, draw = int(m.group(1)), int(m.group(3) or 2)
-        if (seed, draw) in seen:
+        if (seed, draw) in seen or not lo <= seed <= hi:
             continue
         seen[(seed, draw)] = m
+    if bands:
+        print_bands(seen)
+        return
     outcomes, classes = Counter(), Counter()
     lines = {c: [] for c in CLASSES}
     for (seed, draw), m in seen.items():
