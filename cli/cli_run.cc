@@ -437,8 +437,12 @@ int Info(const std::string& path, const std::vector<std::string>& set) {
     const double h_tether = m->opt.timestep / std::max(1, t->SubstepsFor(m->opt.timestep));
     std::cout << "    segment axial mode: omega_n " << t->SegmentModeFrequency()
               << " rad/s, omega_n h " << t->SegmentModeFrequency() * h_tether
-              << ", damping ratio " << t->SegmentModeRatio()
-              << (mjtether::WatchesRinging(*t, m->opt.timestep)
+              << ", damping ratio " << t->SegmentModeRatio();
+    if (t->StepsAsBackwardEuler()) {
+      std::cout << " (above " << mjtether::kSecondOrderMaxDampingRatio
+                << ": this tether steps as backward Euler)";
+    }
+    std::cout << (mjtether::WatchesRinging(*t, m->opt.timestep)
                       ? " (undamped but for the step's numerical damping: a snap's ringing makes the "
                         "tensions depend on the step; damping_ratio=1 damps it)"
                       : "")

@@ -1859,6 +1859,21 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
         set->warnings.push_back(s.str());
       }
     }
+    // bdf2 and implicit2 on an overdamped segment mode step as backward Euler (Tether::Step):
+    // say so, with the damping that keeps their second order.
+    if (t.StepsAsBackwardEuler()) {
+      std::ostringstream s;
+      s << where << "integrator=" << IntegratorName(p.integrator)
+        << " steps as backward Euler (integrator=implicit) here: the segment axial mode's "
+           "damping ratio "
+        << t.SegmentModeRatio() << " is above " << kSecondOrderMaxDampingRatio
+        << ", where bdf2's and implicit2's steps read tensions several times too high "
+           "(docs/limitations.md); set integrator=implicit to say so, or damping <= "
+        << p.damping * kSecondOrderMaxDampingRatio / t.SegmentModeRatio() << " N s (damping_ratio <= "
+        << kSecondOrderMaxDampingRatio << ") to keep " << IntegratorName(p.integrator)
+        << "'s second order";
+      set->warnings.push_back(s.str());
+    }
     for (int end = 0; end < 2; ++end) {
       if (!at.coupled[end]) continue;
       if (!d) {

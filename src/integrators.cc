@@ -1017,7 +1017,10 @@ void Tether::Bdf2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, doubl
 
 void Tether::Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h, double* work,
                   StepStatus* status, const History* history) const {
-  if (p_.integrator == Integrator::kBdf2) {
+  if (StepsAsBackwardEuler()) {
+    // bdf2 or implicit2 on an overdamped segment mode (kSecondOrderMaxDampingRatio).
+    ImplicitStepAdaptive(x, v, now, next, h, 0, work, status);
+  } else if (p_.integrator == Integrator::kBdf2) {
     // Without a history (a winch tether advanced without one): backward Euler.
     if (history) {
       Bdf2Step(x, v, now, next, h, work, status, *history);

@@ -135,6 +135,14 @@ struct StaticResult {
   std::string reason;       // why the shape is unusable (!ok)
 };
 
+// [-] The segment axial mode's damping ratio (Tether::SegmentModeRatio) above which bdf2 and
+// implicit2 step as backward Euler (Tether::StepsAsBackwardEuler). A tether of 39 segments of
+// 7.5 cm between two fixed ends, axial damping far above critical (scene fuzzer seed 10116,
+// reduced; docs/limitations.md, session 29): bdf2 read its tension 6x too high at damping
+// ratio 15.5 (right at 10.9, at every step from 0.05 to 2 ms), implicit2 2.2x at 4.7 (right at
+// 3.1); backward Euler right at each. Below both.
+constexpr double kSecondOrderMaxDampingRatio = 3;
+
 class Tether {
  public:
   // Precomputes masses, coefficients and the explicit stability limit. Returns nothing (and
@@ -278,6 +286,14 @@ class Tether {
   // ratio damping / (L0 sqrt(EA mu)) [-] (0 without the damping effect).
   double SegmentModeFrequency() const { return segment_mode_w_; }
   double SegmentModeRatio() const { return segment_mode_ratio_; }
+  // integrator=bdf2 or implicit2 whose segment axial mode is overdamped beyond
+  // kSecondOrderMaxDampingRatio steps as backward Euler (integrator=implicit), every step:
+  // there the two-step history of BDF2, and SDIRK's stages, against the damped law's clip at
+  // zero tension made a period-2 alternation that grew (docs/limitations.md, session 29).
+  bool StepsAsBackwardEuler() const {
+    return (p_.integrator == Integrator::kBdf2 || p_.integrator == Integrator::kImplicit2) &&
+           segment_mode_ratio_ > kSecondOrderMaxDampingRatio;
+  }
   // [N] The largest snap a step of dt from the state (x, v) would start: over the slack
   // segments whose nodes separate fast enough to reach the rest length within dt, the axial
   // wave's tension jump sqrt(EA mu) times the separation speed (0 if none). A cheap look-ahead

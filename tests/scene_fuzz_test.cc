@@ -1736,13 +1736,16 @@ TEST(SceneFuzzOracle, AStretchedStartIsWarnedOnlyWhereItsUnstretchedTwinAgrees) 
   EXPECT_FALSE(failed.pass) << failed.detail;
   EXPECT_EQ(failed.kind, "disagrees with 10x smaller step");
   EXPECT_TRUE(Contains(failed.detail, "started unstretched: disagrees")) << failed.detail;
-  // Seed 12100 (implicit2, strain 0.43): the 0.2 ms run diverges on the release's snap
-  // (strain beyond max_strain), the 2 ms run goes on; started unstretched it agrees.
-  const Outcome fine_failed = Judge(Make(12100, kDraw));
-  EXPECT_TRUE(fine_failed.pass) << fine_failed.kind << ": " << fine_failed.detail;
-  EXPECT_EQ(fine_failed.kind, kWarnedStretched);
-  EXPECT_TRUE(Contains(fine_failed.detail, "fine step failed")) << fine_failed.detail;
-  EXPECT_TRUE(Contains(fine_failed.detail, "started unstretched: agrees")) << fine_failed.detail;
+  // Seed 12100 (implicit2, strain 0.43, segment damping ratio 272): until session 29 its 0.2 ms
+  // run diverged on the release's snap (strain beyond max_strain) while the 2 ms run went on,
+  // and started unstretched it agreed: warned. That divergence was implicit2's own step on an
+  // overdamped segment mode, which now steps as backward Euler (kSecondOrderMaxDampingRatio),
+  // and the 0.2 ms run goes on: the scene agrees with its refinements. It was the only scene
+  // of seeds 1-15000 with that outcome, so the warned outcome's fine-step-failed branch has no
+  // example left here (the branch stays: JudgeRuns).
+  const Outcome fine_ran = Judge(Make(12100, kDraw));
+  EXPECT_TRUE(fine_ran.pass) << fine_ran.kind << ": " << fine_ran.detail;
+  EXPECT_FALSE(Contains(fine_ran.detail, "fine step failed")) << fine_ran.detail;
   mju_user_warning = previous;
   // A warning without the step's caveat does not excuse a disagreement.
   EXPECT_FALSE(WarnsStepDependence("starts stretched, far from equilibrium"));
