@@ -1869,8 +1869,9 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
         << t.SegmentModeRatio() << " is above " << kSecondOrderMaxDampingRatio
         << ", where bdf2's and implicit2's steps read tensions several times too high "
            "(docs/limitations.md); set integrator=implicit to say so, or damping <= "
-        << p.damping * kSecondOrderMaxDampingRatio / t.SegmentModeRatio() << " N s (damping_ratio <= "
-        << kSecondOrderMaxDampingRatio << ") to keep " << IntegratorName(p.integrator)
+        << p.damping * kSecondOrderMaxDampingRatio / t.SegmentModeRatio()
+        << " N s (damping_ratio <= " << kSecondOrderMaxDampingRatio << ") to keep "
+        << IntegratorName(p.integrator)
         << "'s second order";
       set->warnings.push_back(s.str());
     }

@@ -141,7 +141,9 @@ double Tether::DrumImpedance(const double* xp, const Payout& p, double dt) const
   // The step the integrator's implicit solve takes (the inertia and damping it sees): bdf2's
   // is a backward-Euler step of 2 dt/3, implicit2's stages are of (1 - 1/sqrt 2) dt each.
   // explicit and rk4 follow the true dynamics over dt, which backward Euler's stands in for.
-  const double he = view.p_.integrator == Integrator::kBdf2        ? dt * 2 / 3
+  // bdf2 and implicit2 on an overdamped segment mode take backward Euler's (StepsAsBackwardEuler).
+  const double he = view.StepsAsBackwardEuler()                    ? dt
+                    : view.p_.integrator == Integrator::kBdf2        ? dt * 2 / 3
                     : view.p_.integrator == Integrator::kImplicit2 ? dt * 0.29289321881345248
                                                                    : dt;
   const double inv_dt2 = 1 / (he * he);
