@@ -37,7 +37,7 @@ TEST_P(CouplingCases, AgreeWithTheFineStepOrAreRefusedAtLoad) {
   const auto [EA, integrator] = GetParam();
   InstallErrorHandlers();
   std::string error;
-  mjModel* m = LoadModelFromString(BlueRovXml(EA, integrator, 0.002), "case.xml", &error);
+  testing::ModelPtr m(LoadModelFromString(BlueRovXml(EA, integrator, 0.002), "case.xml", &error));
   if (!m) {
     // Refused: only the explicit schemes, above the coupling limit, naming it and the fix.
     EXPECT_TRUE(std::string(integrator) == "explicit" || std::string(integrator) == "rk4" ||
@@ -57,17 +57,15 @@ TEST_P(CouplingCases, AgreeWithTheFineStepOrAreRefusedAtLoad) {
   }
   // The 0.1 ms reference, only for a case that loads (rk4 at EA 1e8 is refused at 0.1 ms too:
   // omega h 0.53 against its limit 0.5).
-  mjModel* fine = LoadModelFromString(BlueRovXml(EA, integrator, 1e-4), "fine.xml", &error);
+  testing::ModelPtr fine(LoadModelFromString(BlueRovXml(EA, integrator, 1e-4), "fine.xml", &error));
   ASSERT_NE(fine, nullptr) << error;
   std::string stopped;
-  const std::vector<Sample> ref = RunScene(fine, 1.5, &stopped);
-  Detach(fine);
-  mj_deleteModel(fine);
+  const std::vector<Sample> ref = RunScene(fine.get(), 1.5, &stopped);
+  fine.reset();
   ASSERT_EQ(stopped, "") << "the 0.1 ms reference must run";
 
-  const std::vector<Sample> got = RunScene(m, 1.5, &stopped);
-  Detach(m);
-  mj_deleteModel(m);
+  const std::vector<Sample> got = RunScene(m.get(), 1.5, &stopped);
+  m.reset();
   ASSERT_EQ(stopped, "");
   ASSERT_EQ(got.size(), ref.size());
   const double travel = (ref.back().pos - ref.front().pos).norm();

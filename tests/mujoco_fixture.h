@@ -7,6 +7,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -47,6 +48,16 @@ inline std::optional<std::string> StepUntilDivergence(const mjModel* m, mjData* 
   }
   return std::nullopt;
 }
+
+// Owns a model loaded with its tethers: detaches them and deletes the model when it goes out of
+// scope, also where an ASSERT returns early.
+struct ModelDeleter {
+  void operator()(mjModel* m) const {
+    Detach(m);
+    mj_deleteModel(m);
+  }
+};
+using ModelPtr = std::unique_ptr<mjModel, ModelDeleter>;
 
 inline void FailOnWarning(const char* message) {
   ADD_FAILURE() << "MuJoCo warning: " << message;
