@@ -439,7 +439,7 @@ int Info(const std::string& path, const std::vector<std::string>& set) {
               << " rad/s, omega_n h " << t->SegmentModeFrequency() * h_tether
               << ", damping ratio " << t->SegmentModeRatio();
     if (t->StepsAsBackwardEuler()) {
-      std::cout << " (above " << mjtether::kSecondOrderMaxDampingRatio
+      std::cout << " (above " << t->SecondOrderMaxDampingRatio()
                 << ": this tether steps as backward Euler)";
     }
     std::cout << (mjtether::WatchesRinging(*t, m->opt.timestep)

@@ -1872,17 +1872,17 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
     // bdf2 and implicit2 on an overdamped segment mode step as backward Euler (Tether::Step):
     // say so, with the damping that keeps their second order.
     if (t.StepsAsBackwardEuler()) {
+      const double limit = t.SecondOrderMaxDampingRatio();  // [-]
       std::ostringstream s;
       s << where << "integrator=" << IntegratorName(p.integrator)
         << " steps as backward Euler (integrator=implicit) here: the segment axial mode's "
            "damping ratio "
-        << t.SegmentModeRatio() << " is above " << kSecondOrderMaxDampingRatio
-        << ", where bdf2's and implicit2's steps read tensions several times too high "
-           "(docs/limitations.md); set integrator=implicit to say so, or damping <= "
-        << p.damping * kSecondOrderMaxDampingRatio / t.SegmentModeRatio()
-        << " N s (damping_ratio <= " << kSecondOrderMaxDampingRatio << ") to keep "
+        << t.SegmentModeRatio() << " is above " << limit << ", where "
         << IntegratorName(p.integrator)
-        << "'s second order";
+        << "'s steps read tensions several times too high (docs/limitations.md); set "
+           "integrator=implicit to say so, or damping <= "
+        << p.damping * limit / t.SegmentModeRatio() << " N s (damping_ratio <= " << limit
+        << ") to keep " << IntegratorName(p.integrator) << "'s second order";
       set->warnings.push_back(s.str());
     }
     for (int end = 0; end < 2; ++end) {

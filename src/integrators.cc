@@ -1018,7 +1018,7 @@ void Tether::Bdf2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, doubl
 void Tether::Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h, double* work,
                   StepStatus* status, const History* history) const {
   if (StepsAsBackwardEuler()) {
-    // bdf2 or implicit2 on an overdamped segment mode (kSecondOrderMaxDampingRatio).
+    // bdf2 or implicit2 on an overdamped segment mode (SecondOrderMaxDampingRatio).
     ImplicitStepAdaptive(x, v, now, next, h, 0, work, status);
   } else if (p_.integrator == Integrator::kBdf2) {
     // Without a history (a winch tether advanced without one): backward Euler.

@@ -136,12 +136,16 @@ struct StaticResult {
 };
 
 // [-] The segment axial mode's damping ratio (Tether::SegmentModeRatio) above which bdf2 and
-// implicit2 step as backward Euler (Tether::StepsAsBackwardEuler). A tether of 39 segments of
-// 7.5 cm between two fixed ends, axial damping far above critical (scene fuzzer seed 10116,
-// reduced; docs/limitations.md, session 29): bdf2 read its tension 6x too high at damping
-// ratio 15.5 (right at 10.9, at every step from 0.05 to 2 ms), implicit2 2.2x at 4.7 (right at
-// 3.1); backward Euler right at each. Below both.
-constexpr double kSecondOrderMaxDampingRatio = 3;
+// implicit2 step as backward Euler (Tether::StepsAsBackwardEuler), each at its own onset. A
+// tether of 39 segments of 7.5 cm between two fixed ends, axial damping far above critical
+// (scene fuzzer seed 10116, reduced; docs/limitations.md, session 29): bdf2 read its tension 6x
+// too high at damping ratio 15.5 (right at 10.9, at every step from 0.05 to 2 ms), implicit2
+// 2.2x at 4.7 (right at 3.1); backward Euler right at each. The fuzzer scenes this fixed had
+// ratios of 22-320. Session 29 took 3 for both; that made bdf2 first order on the
+// accuracy/cost line at 320 segments (ratio 3.2: the fairlead error at 10 ms 1.35 N where its
+// own step reads 0.047 N), so bdf2's limit is 10 since session 30.
+constexpr double kSecondOrderMaxDampingRatioBdf2 = 10;
+constexpr double kSecondOrderMaxDampingRatioImplicit2 = 3;
 
 class Tether {
  public:
@@ -287,12 +291,16 @@ class Tether {
   double SegmentModeFrequency() const { return segment_mode_w_; }
   double SegmentModeRatio() const { return segment_mode_ratio_; }
   // integrator=bdf2 or implicit2 whose segment axial mode is overdamped beyond
-  // kSecondOrderMaxDampingRatio steps as backward Euler (integrator=implicit), every step:
+  // its SecondOrderMaxDampingRatio steps as backward Euler (integrator=implicit), every step:
   // there the two-step history of BDF2, and SDIRK's stages, against the damped law's clip at
   // zero tension made a period-2 alternation that grew (docs/limitations.md, session 29).
-  bool StepsAsBackwardEuler() const {
-    return (p_.integrator == Integrator::kBdf2 || p_.integrator == Integrator::kImplicit2) &&
-           segment_mode_ratio_ > kSecondOrderMaxDampingRatio;
+  bool StepsAsBackwardEuler() const { return segment_mode_ratio_ > SecondOrderMaxDampingRatio(); }
+  // [-] The damping ratio above which this tether's integrator steps as backward Euler:
+  // kSecondOrderMaxDampingRatioBdf2 or ...Implicit2; infinity for the others.
+  double SecondOrderMaxDampingRatio() const {
+    return p_.integrator == Integrator::kBdf2        ? kSecondOrderMaxDampingRatioBdf2
+           : p_.integrator == Integrator::kImplicit2 ? kSecondOrderMaxDampingRatioImplicit2
+                                                     : INFINITY;
   }
   // [N] The largest snap a step of dt from the state (x, v) would start: over the slack
   // segments whose nodes separate fast enough to reach the rest length within dt, the axial

@@ -1739,10 +1739,10 @@ TEST(SceneFuzzOracle, AStretchedStartIsWarnedOnlyWhereItsUnstretchedTwinAgrees) 
   // Seed 12100 (implicit2, strain 0.43, segment damping ratio 272): until session 29 its 0.2 ms
   // run diverged on the release's snap (strain beyond max_strain) while the 2 ms run went on,
   // and started unstretched it agreed: warned. That divergence was implicit2's own step on an
-  // overdamped segment mode, which now steps as backward Euler (kSecondOrderMaxDampingRatio),
-  // and the 0.2 ms run goes on: the scene agrees with its refinements. It was the only scene
-  // of seeds 1-15000 with that outcome, so the warned outcome's fine-step-failed branch has no
-  // example left here (the branch stays: JudgeRuns).
+  // overdamped segment mode, which now steps as backward Euler
+  // (kSecondOrderMaxDampingRatioImplicit2), and the 0.2 ms run goes on: the scene agrees with
+  // its refinements. It was the only scene of seeds 1-15000 with that outcome, so the warned
+  // outcome's fine-step-failed branch has no example left here (the branch stays: JudgeRuns).
   const Outcome fine_ran = Judge(Make(12100, kDraw));
   EXPECT_TRUE(fine_ran.pass) << fine_ran.kind << ": " << fine_ran.detail;
   EXPECT_FALSE(Contains(fine_ran.detail, "fine step failed")) << fine_ran.detail;
