@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "mjtether.h"
+#include "mujoco_fixture.h"
 #include "render.h"
 #include "render_geometry.h"
 
@@ -77,13 +78,6 @@ std::vector<GalleryRender> ReadGallery() {
   return out;
 }
 
-struct ModelDeleter {
-  void operator()(mjModel* m) const {
-    Detach(m);
-    mj_deleteModel(m);
-  }
-};
-
 using test_util::ProjectGl;
 
 // Box bounding the projections of body b's visible geoms through pose p in a W x H viewport.
@@ -129,7 +123,7 @@ TEST(GalleryScript, HasRenderCommands) {
 TEST_P(Gallery, VehicleSeenAndTetherOffTheOverlaysInEveryFrame) {
   const GalleryRender& g = GetParam();
   std::string error;
-  std::unique_ptr<mjModel, ModelDeleter> model(
+  testing::ModelPtr model(
       LoadModel(std::string(MJTETHER_SOURCE_DIR) + "/" + g.model, &error));
   ASSERT_NE(model, nullptr) << error;
   mjModel* m = model.get();

@@ -22,6 +22,7 @@
 
 #include "cli_shell.h"
 #include "mjtether.h"
+#include "mujoco_fixture.h"
 #include "render.h"
 #include "render_geometry.h"
 
@@ -40,13 +41,6 @@ std::array<double, 4> BodyBox(const mjModel* m, const mjData* d, int b, const mj
                               int H) {
   return test_util::BodyBox(m, d, b, [&](const double* x) { return ProjectGl(c, W, H, x); });
 }
-
-struct ModelDeleter {
-  void operator()(mjModel* m) const {
-    Detach(m);
-    mj_deleteModel(m);
-  }
-};
 
 struct Scene {
   const char* file;
@@ -69,7 +63,7 @@ class ShippedScene : public ::testing::TestWithParam<std::tuple<Scene, const cha
 TEST_P(ShippedScene, VehicleSeenOverlaysOffTheTetherAndSmoothCamera) {
   const Scene scene = std::get<0>(GetParam());
   std::string error;
-  std::unique_ptr<mjModel, ModelDeleter> model(
+  testing::ModelPtr model(
       LoadModel(std::string(MJTETHER_MODELS_DIR) + "/" + scene.file, &error));
   ASSERT_NE(model, nullptr) << error;
   mjModel* m = model.get();
@@ -164,7 +158,7 @@ INSTANTIATE_TEST_SUITE_P(
 // nothing cut or overlapping outside them).
 TEST(Layout, OverlaysFitAndDrawOnlyInsideTheirRectangles) {
   std::string error;
-  std::unique_ptr<mjModel, ModelDeleter> model(
+  testing::ModelPtr model(
       LoadModel(std::string(MJTETHER_MODELS_DIR) + "/manoeuvre_station_keeping.xml", &error));
   ASSERT_NE(model, nullptr) << error;
   mjModel* m = model.get();
@@ -336,7 +330,7 @@ TEST(VehicleLooks, MassInertiaAndContactsStayAsDeclared) {
                              {"workclass_rov_tms.xml", 4000, {2667, 4333, 4333}}};
   for (const Declared& x : models) {
     std::string error;
-    std::unique_ptr<mjModel, ModelDeleter> model(
+    testing::ModelPtr model(
         LoadModel(std::string(MJTETHER_MODELS_DIR) + "/" + x.file, &error));
     ASSERT_NE(model, nullptr) << error;
     const mjModel* m = model.get();
