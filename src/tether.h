@@ -467,14 +467,18 @@ class Tether {
   double head_mass_[2] = {0, 0}, head_added_[2] = {0, 0}, head_inv_mass_[2] = {0, 0},
          head_inv_mass_normal_[2] = {0, 0}, head_share_[2] = {0, 0};
   Vec3 head_weight_[2] = {Vec3::Zero(), Vec3::Zero()};
-  double Mass(int i) const { return i < head_ ? head_mass_[i] : mass_[i]; }
-  double Added(int i) const { return i < head_ ? head_added_[i] : added_[i]; }
-  double InvMass(int i) const { return i < head_ ? head_inv_mass_[i] : inv_mass_[i]; }
+  // Whether node i takes the head's lumped values (head_ is 0 or 2). Written with i < 2 so
+  // that GCC sees the head arrays' bounds: with i < head_ its -Warray-bounds flags an inlined
+  // constant index (head_mass_[17]) on the branch that is never taken.
+  bool InHead(int i) const { return head_ != 0 && i < 2; }
+  double Mass(int i) const { return InHead(i) ? head_mass_[i] : mass_[i]; }
+  double Added(int i) const { return InHead(i) ? head_added_[i] : added_[i]; }
+  double InvMass(int i) const { return InHead(i) ? head_inv_mass_[i] : inv_mass_[i]; }
   double InvMassNormal(int i) const {
-    return i < head_ ? head_inv_mass_normal_[i] : inv_mass_normal_[i];
+    return InHead(i) ? head_inv_mass_normal_[i] : inv_mass_normal_[i];
   }
-  double Share(int i) const { return i < head_ ? head_share_[i] : share_[i]; }
-  Vec3 Weight(int i) const { return i < head_ ? head_weight_[i] : Vec3(weight_ + 3 * i); }
+  double Share(int i) const { return InHead(i) ? head_share_[i] : share_[i]; }
+  Vec3 Weight(int i) const { return InHead(i) ? head_weight_[i] : Vec3(weight_ + 3 * i); }
   ConstNodes WeightMatrix() const { return ConstNodes(weight_, 3, N_ + 1); }
   // Stretched length over which node i collects the distributed drag [m]: half of each
   // adjacent segment (l the stretched segment lengths). In a Deployed view (winch), the
