@@ -262,6 +262,15 @@ EndState SiteState(const mjModel* m, const mjData* d, const AttachedTether& at, 
   return e;
 }
 
+// Applies end `end`'s reaction on its body (force [N] and moment [N m], world frame) at the
+// attachment site, so that the force's lever arm about the body's centre of mass is the
+// site's. The one place every path (held force, consistent coupling) applies a reaction.
+void ApplyEndReaction(const mjModel* m, mjData* d, const AttachedTether& at, int end,
+                      const double* force, const double* torque) {
+  mj_applyFT(m, d, force, torque, d->site_xpos + 3 * at.site[end], at.body[end],
+             d->qfrc_passive);
+}
+
 void StoreEnd(const EndState& e, double* dst) {
   for (int i = 0; i < 3; ++i) {
     dst[i] = e.pos[i];
@@ -523,8 +532,7 @@ void EvaluateLead(const mjModel* m, mjData* d, const AttachedTether& at, double*
   // End A is on the world, a mocap body or a body without degrees of freedom: only end B's
   // body moves under the tether.
   auto apply = [&]() {
-    mj_applyFT(m, d, cache + 6, cache + 9, d->site_xpos + 3 * at.site[1], at.body[1],
-               d->qfrc_passive);
+    ApplyEndReaction(m, d, at, 1, cache + 6, cache + 9);
   };
   if (!restart && d->time == u[kTime]) return apply();  // the same step again
   const double h = m->opt.timestep;
@@ -846,12 +854,10 @@ void Evaluate(const mjModel* m, mjData* d, const AttachedTether& at, double* wor
   u[kTensionA] = stored.tension_a;
   u[kTensionB] = stored.tension_b;
   if (at.body[0] > 0 && !at.mocap[0]) {
-    mj_applyFT(m, d, r.force_a.data(), r.torque_a.data(), d->site_xpos + 3 * at.site[0],
-               at.body[0], d->qfrc_passive);
+    ApplyEndReaction(m, d, at, 0, r.force_a.data(), r.torque_a.data());
   }
   if (!free_end && at.body[1] > 0 && !at.mocap[1]) {
-    mj_applyFT(m, d, r.force_b.data(), r.torque_b.data(), d->site_xpos + 3 * at.site[1],
-               at.body[1], d->qfrc_passive);
+    ApplyEndReaction(m, d, at, 1, r.force_b.data(), r.torque_b.data());
   }
 }
 
