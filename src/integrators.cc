@@ -83,8 +83,17 @@ inline Vec3 Tether::Acceleration(int i, const Vec3& fi, const Vec3& qi) const {
 // acceleration it has without the tether. The explicit schemes' share of what ImplicitStep
 // assembles for the same node; one 3x3 SPD solve (Cholesky).
 Vec3 Tether::BodyEndAcceleration(const Vec3& fi, const Vec3& qi, const EndInertia& body) const {
-  Mat3 M = body.mass + Mass(N_) * Mat3::Identity();
-  if (Has(kAddedMass)) M += Added(N_) * (Mat3::Identity() - qi * qi.transpose());
+  // End node B's own inertia only where EndInertia::node_inertia keeps it or the node outweighs
+  // the body's lightest effective mass (the rule of ImplicitStep's node_b_mass); otherwise the
+  // node and the body move as the body's mass alone, as the held force has them.
+  using Eigen::EigenvaluesOnly;
+  const double body_min_mass =
+      Eigen::SelfAdjointEigenSolver<Mat3>(body.mass, EigenvaluesOnly).eigenvalues().minCoeff();
+  Mat3 M = body.mass;
+  if (body.node_inertia || NodeInertiaMax(N_) > body_min_mass) {
+    M += Mass(N_) * Mat3::Identity();
+    if (Has(kAddedMass)) M += Added(N_) * (Mat3::Identity() - qi * qi.transpose());
+  }
   return M.llt().solve(fi + body.force);
 }
 

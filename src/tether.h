@@ -44,7 +44,7 @@ struct EndState {
 // coupling): with it, a tether made by Tether::WithDynamicEndB() steps its end node B as a
 // dynamic node carrying the body's effective mass W^-1 besides its own, under the force
 // W^-1 a_other that gives the site the acceleration a_other it has without the tether.
-// node_inertia false (EvaluateLead with the implicit schemes): end node B's own inertia (mass,
+// node_inertia false (EvaluateLead, every scheme): end node B's own inertia (mass,
 // normal added mass) is left out of its step where it is no heavier than the body's lightest
 // effective mass, so that the node and the body move as the body's mass alone, as the held
 // force has them (docs/coupling.md, "session 11, s11coup"); its forces (segment, weight, drag)
