@@ -199,8 +199,8 @@ TEST_F(LightVehicle, CarriedByTheCurrentAgreesWithItsFineStep) {
 // explicit's step (until session 32, the implicit schemes having left it out since session 11)
 // the 2 ms run started at 19.4 N against 25.4 N and the vehicle was 5.1 cm off the reference
 // within 1 s (0.2 ms likewise: two models, each converged). Asserted at 2 ms against 0.02 ms,
-// sampled every 0.05 s for 1 s: the vehicle within 5 mm (it moves 0.76 m; measured 1.5 mm, 51
-// mm before) and the tension within 5% from 0.2 s on (3.5-7 N; printed; 21% before).
+// sampled every 0.05 s for 1 s: the vehicle within 5 mm (it moves 0.79 m; measured 1.5 mm, 51
+// mm before) and the tension within 5% from 0.2 s on (3.5-7 N; measured 3.3%, 21% before).
 TEST_F(LightVehicle, ExplicitCarriesNoEndNodeInertiaAndAgreesWithItsFineStep) {
   auto xml = [&](double h) {
     return std::string("<mujoco><option timestep=\"") + std::to_string(h) +
@@ -392,8 +392,8 @@ TEST_F(LightVehicle, MomentumChangeIsTheAnchorsImpulse) {
     // End node B is not counted (session 11, s11coup; explicit since session 32): its inertia
     // is taken out of the step, the node and the body moving as the body's mass alone, as with
     // the held force (counted, the balance read 1.9e-3 N s off of 0.39 N s with implicit, its
-    // m_B dv_B; explicit, which kept the node's inertia until session 32, reads 7.1e-3 N s off
-    // of 1.46 N s without it counted).
+    // m_B dv_B; explicit, whose step kept the node's inertia until session 32 and which was
+    // counted with the node until then, now reads 7.1e-3 N s off of 1.46 N s so counted).
     const MomentumBalance b =
         RunMomentumBalance(m, Make(m), 5, std::string(integrator).rfind("bdf2", 0) == 0, false);
     ASSERT_EQ(b.stopped, "") << integrator;
