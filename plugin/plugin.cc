@@ -577,9 +577,9 @@ void EvaluateLead(const mjModel* m, mjData* d, const AttachedTether& at, double*
   // held force, by m_B a_B, the scene fuzzer's "coupling" class (docs/coupling.md, "session 11,
   // s11coup"). With explicit too since session 32 (it had kept the node's inertia: a run
   // 4.6 cm and 6 N off its fine-step self, the held force, on a 4.7 kg vehicle with a 2 kg end
-  // node, fuzzer seed 10173's scene; docs/coupling.md). ImplicitStep and BodyEndAcceleration
-  // leave it out only where the node is no heavier than the body's lightest effective mass.
-  body.node_inertia = false;
+  // node, fuzzer seed 10173's scene; docs/coupling.md). Kept only where the node outweighs the
+  // body's lightest effective mass (session 23), decided here once per step for every scheme.
+  body.node_inertia = tether.EndNodeOutweighs(W_inv);
   // The site's acceleration from the passive forces already applied at this call (MuJoCo's own,
   // the vehicles' buoyancy, damping and added-mass remainder, tethers evaluated before this
   // one): M^-1 J^T is in jac after SiteInverseMass, so each is a dot product with qfrc_passive.

@@ -83,18 +83,19 @@ inline Vec3 Tether::Acceleration(int i, const Vec3& fi, const Vec3& qi) const {
 // acceleration it has without the tether. The explicit schemes' share of what ImplicitStep
 // assembles for the same node; one 3x3 SPD solve (Cholesky).
 Vec3 Tether::BodyEndAcceleration(const Vec3& fi, const Vec3& qi, const EndInertia& body) const {
-  // End node B's own inertia only where EndInertia::node_inertia keeps it or the node outweighs
-  // the body's lightest effective mass (the rule of ImplicitStep's node_b_mass); otherwise the
-  // node and the body move as the body's mass alone, as the held force has them.
-  using Eigen::EigenvaluesOnly;
-  const double body_min_mass =
-      Eigen::SelfAdjointEigenSolver<Mat3>(body.mass, EigenvaluesOnly).eigenvalues().minCoeff();
   Mat3 M = body.mass;
-  if (body.node_inertia || NodeInertiaMax(N_) > body_min_mass) {
+  if (body.node_inertia) {  // EndInertia::node_inertia (EndNodeOutweighs)
     M += Mass(N_) * Mat3::Identity();
     if (Has(kAddedMass)) M += Added(N_) * (Mat3::Identity() - qi * qi.transpose());
   }
   return M.llt().solve(fi + body.force);
+}
+
+bool Tether::EndNodeOutweighs(const Mat3& body_mass) const {
+  using Eigen::EigenvaluesOnly;
+  const double body_min_mass =  // [kg]
+      Eigen::SelfAdjointEigenSolver<Mat3>(body_mass, EigenvaluesOnly).eigenvalues().minCoeff();
+  return NodeInertiaMax(N_) > body_min_mass;
 }
 
 // Symplectic (semi-implicit) Euler: v += h M^-1 f(x, v); x += h v. With a body at end B
@@ -275,10 +276,7 @@ bool Tether::ImplicitStep(Nodes x, Nodes v, const Ends& now, const Ends& next, d
            : 0;  // [kg]
   // End node B's own inertia in its row (EndInertia::node_inertia): without it the node moves
   // with the body's mass alone.
-  // Only where the node is no heavier than the body's lightest effective mass: seed 2499 (bdf2,
-  // a 27 kg end node of 4 segments on a 6 kg vehicle) read 408 N for 2.4 N without that
-  // condition (not diagnosed).
-  const bool node_b_mass = !body || body->node_inertia || NodeInertiaMax(N_) > body_min_mass;
+  const bool node_b_mass = !body || body->node_inertia;
 
   // Forces at the iterate, and the residual -G = h f - M (v+ - v) (node mass with normal added
   // mass) into rhs. Returns phi*2 and, in *err, the largest |G_i|/m_i [m/s].
