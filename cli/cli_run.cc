@@ -433,7 +433,8 @@ int Info(const std::string& path, const std::vector<std::string>& set) {
     if (st.w_seabed > 0) std::cout << ", seabed omega " << st.w_seabed << " rad/s";
     std::cout << ", damping rate " << st.rate << " 1/s\n";
     // The segment axial mode (docs/reference.md "Internal damping"): the ringing after a snap
-    // that an implicit step damps and a smaller one resolves (RingWarnings at a run's end).
+    // that an implicit step damps and a smaller one resolves, and whose energy an explicit
+    // scheme keeps as the step left it (RingWarnings at a run's end).
     const double h_tether = m->opt.timestep / std::max(1, t->SubstepsFor(m->opt.timestep));
     std::cout << "    segment axial mode: omega_n " << t->SegmentModeFrequency()
               << " rad/s, omega_n h " << t->SegmentModeFrequency() * h_tether
@@ -442,10 +443,13 @@ int Info(const std::string& path, const std::vector<std::string>& set) {
       std::cout << " (above " << t->SecondOrderMaxDampingRatio()
                 << ": this tether steps as backward Euler)";
     }
-    std::cout << (mjtether::WatchesRinging(*t, m->opt.timestep)
-                      ? " (undamped but for the step's numerical damping: a snap's ringing makes the "
-                        "tensions depend on the step; damping_ratio=1 damps it)"
-                      : "")
+    std::cout << (!mjtether::WatchesRinging(*t, m->opt.timestep) ? ""
+                  : mjtether::IsExplicit(t->params().integrator)
+                      ? " (undamped: the substeps keep a snap's ringing, with an energy that "
+                        "depends on the step, which makes the tensions depend on it; "
+                        "damping_ratio=1 damps it)"
+                      : " (undamped but for the step's numerical damping: a snap's ringing makes "
+                        "the tensions depend on the step; damping_ratio=1 damps it)")
               << "\n";
     // The whole line's lowest axial mode, ends held: the chain's omega_k = omega_n sin(k pi /
     // 2N), k = 1, and, Kelvin-Voigt damping being proportional to the stiffness, its damping

@@ -198,10 +198,11 @@ std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d);
 // step costs up to 256 times a normal one: a long run should not be silent until its end).
 std::vector<std::string> StallWarnings(const mjModel* m, const mjData* d, bool early = false);
 // The tethers in which a slack segment snapped taut while the segment axial mode is undamped
-// (damping ratio below kRingDampingRatio) and damped by the implicit step: their tensions after the
-// snap depend on the step and on the segment count (docs/reference.md, "Internal damping"). One
-// message per such tether, with the first snap's time, the largest jump and damping_ratio=1 as
-// the cure; empty otherwise. The CLI prints them at the end of a run.
+// (damping ratio below kRingDampingRatio), damped by an implicit step or kept by an explicit one
+// with an energy that depends on the step: their tensions after the snap depend on the step and
+// on the segment count (docs/reference.md, "Internal damping"). One message per such tether,
+// with the first snap's time, the largest jump and damping_ratio=1 as the cure; empty otherwise.
+// The CLI prints them at the end of a run.
 std::vector<std::string> RingWarnings(const mjModel* m, const mjData* d);
 // Everything a run says at its end about the steps it took: StallWarnings, then RingWarnings.
 // `mjtether run` prints these, the step check's fine run reports its own, and Python's
@@ -218,9 +219,10 @@ inline constexpr double kRingDampingRatio = 0.1;
 // damping_ratio=1 brought to agree with their fine step was 0.06 (session 25); below 0.05 a
 // period spans more than 125 steps.
 inline constexpr double kRingOmegaH = 0.05;
-// Whether a tether stepped over `timestep` [s] has its snaps watched for that ringing: an
-// implicit integrator, the segment mode's damping ratio below kRingDampingRatio and its
-// omega_n h above kRingOmegaH (h: the tether's own step), and no winch (its segments change).
+// Whether a tether stepped over `timestep` [s] has its snaps watched for that ringing: any
+// integrator (the explicit ones since session 33), the segment mode's damping ratio below
+// kRingDampingRatio and its omega_n h above kRingOmegaH (h: the tether's own step, an explicit
+// substep), and no winch (its segments change).
 bool WatchesRinging(const Tether& t, double timestep);
 
 // Replaces MuJoCo's default error handler (which waits on stdin) by one that prints the
