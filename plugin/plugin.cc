@@ -1832,7 +1832,7 @@ std::string ChatterRate(Integrator integrator, bool consistent) {
 // force at omega h >= kCouplingAccurate (session 33, from session 32's long runs of seeds
 // 201..15000, `tools/scene_fuzz_classify.py --bands`: runs that went to their end): explicit
 // at 0.1-0.5 off their 10x smaller step 8 times in 356, rk4 at 0.1-0.25 2 in 225, implicit2 at
-// 0.1-0.5 4 in 339; below 0.1 the three 5 in 2659. The warning said "1 in 20" from session 19
+// 0.1-0.5 4 in 339; below 0.1 the three 5 in 2657. The warning said "1 in 20" from session 19
 // (34 of 668 then) to 32.
 std::string HeldRate(Integrator integrator) {
   switch (integrator) {
@@ -2047,7 +2047,7 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
                  c.omega_h >= kCouplingAccurate) {
         // explicit's consistent coupling below half its limit (from kLeadFromExplicit = 0.5):
         // the scene fuzzer's runs at coupling omega h 0.5-1 that ran to the end are off their
-        // 10x smaller step 5 times in 132 on seeds 201..15000 since session 32 (4 in 129 in
+        // 10x smaller step 5 times in 131 on seeds 201..15000 since session 32 (4 in 129 in
         // session 27, 7 in 127 before its Euler path for end node B, Tether::Advance), against
         // 3 in 948 below 0.1.
         // Before that path held-out seed 14999 (7 substeps of the 2 ms
@@ -2058,7 +2058,7 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
         w << where << head << "consistent coupling at coupling omega h = " << c.omega_h
           << " (omega = " << c.omega << " rad/s, <option timestep> " << h << " s, " << n
           << " tether substep(s)), at or above " << kCouplingAccurate
-          << ", where the scene fuzzer finds 5 in 132 such runs off their 10x smaller step "
+          << ", where the scene fuzzer finds 5 in 131 such runs off their 10x smaller step "
           << "(the run-time checks do not see it); use "
           << "integrator=bdf2 (the default) or implicit (the end node is solved with the body "
           << "in one step), or <option timestep> <= " << advised << " s";

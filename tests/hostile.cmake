@@ -6,6 +6,10 @@ target_compile_definitions(hostile_test PRIVATE
   MJTETHER_HOSTILE_DIR="${CMAKE_CURRENT_SOURCE_DIR}/hostile"
   MJTETHER_CLI="$<TARGET_FILE:mjtether>")
 add_dependencies(hostile_test mjtether)
+# The cases are listed when the binary is linked (gtest_discover_tests runs it after the
+# build): a line added to cases.txt must rebuild it, or CTest never runs the new case.
+set_source_files_properties(hostile_test.cc PROPERTIES OBJECT_DEPENDS
+  "${CMAKE_CURRENT_SOURCE_DIR}/hostile/cases.txt")
 gtest_discover_tests(hostile_test NO_PRETTY_VALUES DISCOVERY_TIMEOUT 60 PROPERTIES LABELS hostile)
 
 add_executable(observe_test observe_test.cc)
