@@ -1728,9 +1728,9 @@ TEST(SceneFuzz, TethersThatTouchGeomsOrWinchAreRefusedRunCorrectlyOrDivergeWithA
 // agrees. Seed 7637: explicit, 6 segments, 2.6 t, stretched too, but 0.92 kN against 0.33 kN
 // also unstretched: still a failure. (Seed 7185, rk4, the example from session 29 to 33, rings
 // its undamped segment mode and agrees with damping_ratio=1 since explicit schemes are watched
-// for it: a warned outcome of its own. Seed 582 of draw 1, the example until session 29, is refused
-// at load since rk4's coupling limit is 0.5; seed 399, the one until session 13, agrees
-// unstretched since explicit's stable step was halved.)
+// for it: a warned outcome of its own. Seed 582 of draw 1, the example until session 29, is
+// refused at load since rk4's coupling limit is 0.5; seed 399, the one until session 13,
+// agrees unstretched since explicit's stable step was halved.)
 TEST(SceneFuzzOracle, AStretchedStartIsWarnedOnlyWhereItsUnstretchedTwinAgrees) {
   void (*previous)(const char*) = mju_user_warning;
   mju_user_warning = CountWarning;
