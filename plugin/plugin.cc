@@ -1810,46 +1810,53 @@ void WarnThrustBeyondHolds(const mjModel* m, ModelTethers* set) {
   if (scratch) mj_deleteData(scratch);
 }
 
-// What the scene fuzzer measured above half the coupling limit (seeds 201..15000 on session 28's
-// code, the runs that went to their end; docs/coupling.md, sessions 28 and 29): rk4, whose
-// limit is 0.5 since session 29, 6 of 138 at omega h 0.25-0.5 off their 10x smaller step (at
-// 0.5-0.8, now refused, 7 of 85, one of them seed 913 growing its vehicle-end tension from 11 N
-// to 47 kN in 3 s without a stop); explicit with the consistent coupling (from omega h 0.5) 5
-// of 90 at 1-2. Re-read on session 33's long runs as HeldRate is: rk4 11 of 138 off their 10x
-// smaller step, 1 with no other warning (6 failures until the ringing of explicit schemes was
-// watched), explicit 13 of 88, 1 (4). Said only where measured: the fuzzer's ends are end B on
-// a free body.
+// What the scene fuzzer measured where the coupling warnings below apply, on session 33's long
+// runs of seeds 201..15000 (`tools/scene_fuzz_classify.py --bands`, runs that went to their end;
+// docs/coupling.md, session 33): how many were off their 10x smaller step, and how many of
+// those no other warning named (a stretched start, thrust beyond what the tether holds, a snap
+// ringing the undamped segment mode: the fuzzer's warned outcomes). Said only where measured:
+// the fuzzer's ends are end B on a free body. The held force's warning said "1 in 20" from
+// session 19 (34 of 668 failures then) to 32; above half the limit rk4 had 6 failures in 138 and
+// explicit 5 in 90 (session 28) before the ringing of explicit schemes was watched; rk4 at
+// 0.5-0.8, refused since session 29, had 7 of 85, one of them seed 913 growing its vehicle-end
+// tension from 11 N to 47 kN in 3 s without a stop.
+struct FuzzerRate {
+  int off;     // runs off their 10x smaller step
+  int runs;    // runs that went to their end
+  int silent;  // of the off ones, those no other warning named
+};
+constexpr FuzzerRate kHeldExplicit{18, 356, 2};       // held force, omega h 0.1-0.5
+constexpr FuzzerRate kHeldRk4{8, 225, 1};             // held force, 0.1-0.25
+constexpr FuzzerRate kHeldImplicit2{24, 339, 4};      // held force, 0.1-0.5
+constexpr FuzzerRate kHeldBelow{17, 2657, 1};         // the three, below kCouplingAccurate
+constexpr FuzzerRate kConsistentExplicit{13, 131, 3};  // consistent coupling, 0.5-1
+constexpr FuzzerRate kChatterRk4{11, 138, 1};         // above half the limit, 0.25-0.5
+constexpr FuzzerRate kChatterExplicit{13, 88, 1};     // above half the limit, 1-2
+
+// "the scene fuzzer finds N in M such WHAT off their 10x smaller step (F of them with no other
+// warning)"
+std::string Finds(const FuzzerRate& r, const std::string& what) {
+  return "the scene fuzzer finds " + std::to_string(r.off) + " in " + std::to_string(r.runs) +
+         " such " + what + " off their 10x smaller step (" + std::to_string(r.silent) +
+         " of them with no other warning)";
+}
+
+// The rate above half the limit, for the chatter warning; empty where not measured.
 std::string ChatterRate(Integrator integrator, bool consistent) {
-  if (integrator == Integrator::kRK4) {
-    return "; the scene fuzzer finds 11 in 138 such rk4 runs off their 10x smaller step (1 with "
-           "no other warning)";
-  }
+  if (integrator == Integrator::kRK4) return "; " + Finds(kChatterRk4, "rk4 runs");
   if (integrator == Integrator::kExplicit && consistent) {
-    return "; the scene fuzzer finds 13 in 88 such explicit runs off their 10x smaller step (1 "
-           "with no other warning)";
+    return "; " + Finds(kChatterExplicit, "explicit runs");
   }
   return "";
 }
 
-// What the scene fuzzer measured below half the coupling limit where the body gets the held end
-// force at omega h >= kCouplingAccurate, on session 33's long runs of seeds 201..15000
-// (`tools/scene_fuzz_classify.py --bands`, runs that went to their end): how many were off their
-// 10x smaller step, and how many of those no other warning named (a stretched start, thrust
-// beyond what the tether holds, a snap ringing the undamped segment mode: the fuzzer's warned
-// outcomes). explicit at 0.1-0.5 18 of 356 (2 unnamed), rk4 at 0.1-0.25 8 of 225 (1),
-// implicit2 at 0.1-0.5 24 of 339 (4); the three below 0.1 17 of 2657 (1). The warning said "1
-// in 20" from session 19 (34 of 668 failures then) to 32.
+// The held force's rate below half the limit (only rk4, explicit and implicit2 have a limit and
+// get that warning: CouplingLimit::applies).
 std::string HeldRate(Integrator integrator) {
-  switch (integrator) {
-    case Integrator::kExplicit:
-      return "18 in 356 such explicit runs off their 10x smaller step (2 with no other warning)";
-    case Integrator::kRK4:
-      return "8 in 225 such rk4 runs off their 10x smaller step (1 with no other warning)";
-    case Integrator::kImplicit2:
-      return "24 in 339 such implicit2 runs off their 10x smaller step (4 with no other warning)";
-    default:  // implicit and bdf2 have no limit and get no such warning (CouplingLimit::applies)
-      return "such runs off their 10x smaller step";
-  }
+  const FuzzerRate& r = integrator == Integrator::kRK4        ? kHeldRk4
+                        : integrator == Integrator::kImplicit2 ? kHeldImplicit2
+                                                               : kHeldExplicit;
+  return Finds(r, std::string(IntegratorName(integrator)) + " runs");
 }
 
 // Why a refusal in a band that loaded until session 29 is one: rk4 between its limit and 0.8
@@ -2042,8 +2049,8 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
         w << where << head << "held end force at coupling omega h = " << c.omega_h
           << " (omega = " << c.omega
           << " rad/s, <option timestep> " << h << " s), at or above " << kCouplingAccurate
-          << ", where the scene fuzzer finds " << HeldRate(p.integrator) << ", against 17 in "
-          << "2657, 1 with no other warning, below " << kCouplingAccurate
+          << ", where " << HeldRate(p.integrator) << ", against " << kHeldBelow.off << " in "
+          << kHeldBelow.runs << " below " << kCouplingAccurate
           << " (an end-force chatter can grow without a stop); use integrator=bdf2 (the "
           << "default) or implicit (the end node is solved with the body), or <option "
           << "timestep> <= " << advised << " s";
@@ -2063,8 +2070,8 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
         w << where << head << "consistent coupling at coupling omega h = " << c.omega_h
           << " (omega = " << c.omega << " rad/s, <option timestep> " << h << " s, " << n
           << " tether substep(s)), at or above " << kCouplingAccurate
-          << ", where the scene fuzzer finds 13 in 131 such runs off their 10x smaller step, 3 "
-          << "with no other warning (the run-time coupling checks do not see it); use "
+          << ", where " << Finds(kConsistentExplicit, "runs")
+          << ", which the run-time coupling checks do not see; use "
           << "integrator=bdf2 (the default) or implicit (the end node is solved with the body "
           << "in one step), or <option timestep> <= " << advised << " s";
         set->warnings.push_back(w.str());
