@@ -479,6 +479,8 @@ int Info(const std::string& path, const std::vector<std::string>& set) {
           std::cout << ", end node B (" << c.m_node
                     << " kg with its added mass) outweighing m_eff";
         }
+        // SlowModeCorrection (plugin/plugin.cc): not on a winch.
+        if (!p.winch) std::cout << ", its damping of the body's bounce on the taut line corrected";
       } else if (c.omega_h > 0) {
         std::cout << "; held end force";
       }

@@ -337,10 +337,12 @@ PYBIND11_MODULE(mjtether, mod) {
             out["torque_b"] = Vector(r.torque_b);
             out["tension_a"] = r.tension_a;
             out["tension_b"] = r.tension_b;
+            out["correction_b"] = Vector(r.correction_b);
             return out;
           },
           "end reactions as applied at the last evaluation: force_a, force_b [N] on the sites, "
-          "torque_a, torque_b [N m], tension_a, tension_b [N]")
+          "torque_a, torque_b [N m], tension_a, tension_b [N], correction_b [N] (of force_b, "
+          "the consistent coupling's slow-mode correction, its reaction in force_a)")
       .def_property_readonly("length", &TetherView::Length,
                              "current length along the nodes [m] (stretched)")
       .def_property_readonly(

@@ -505,6 +505,21 @@ double Tether::EndStiffness() const {
 
 double Tether::EndDamping() const { return Has(kDamping) ? p_.damping / L0_ : 0.0; }
 
+Mat3 Tether::LineStiffness(const double* xp) const {
+  ConstNodes x(xp, 3, N_ + 1);
+  Mat3 compliance = Mat3::Zero();  // [m/N]
+  for (int j = 0; j < N_; ++j) {
+    const Vec3 d = x.col(j + 1) - x.col(j);
+    const double l = d.norm(), rest = rest_length(j);
+    const double T = p_.EA * (l / rest - 1);  // [N]
+    if (!(T > 0)) return Mat3::Zero();  // slack (or not finite): no first-order stiffness
+    const Vec3 t = d / l;
+    const Mat3 along = t * t.transpose();
+    compliance += along * (rest / p_.EA) + (Mat3::Identity() - along) * (l / T);
+  }
+  return N_ > 0 ? Mat3(compliance.inverse()) : Mat3::Zero();
+}
+
 double Tether::SnapJump(const double* xp, const double* vp, double dt) const {
   ConstNodes x(xp, 3, N_ + 1), v(vp, 3, N_ + 1);
   double fastest = 0;  // [m/s]

@@ -1059,6 +1059,7 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
   PlaceEnds(from, x, v);
   // explicit and rk4: more substeps where the drag at this advance's speeds needs them.
   steps = DragSubsteps(xp, vp, from, to, dt, steps);
+  status.substeps = steps;
   const double h = dt / steps;
   // bdf2 without a caller's history: one in the workspace for this call (x0, v0 are
   // implicit2's), starting with a backward-Euler step.

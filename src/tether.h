@@ -88,6 +88,10 @@ struct EndReactions {
   Vec3 torque_b = Vec3::Zero();  // [N m]
   double tension_a = 0;          // [N] |force_a|
   double tension_b = 0;          // [N] |force_b|, or the last segment's tension when B is free
+  // [N] of force_b, the consistent coupling's slow-mode correction (a numerical force, not the
+  // line's; its reaction is in force_a), zero elsewhere: the line's own forces on the sites are
+  // force_a + correction_b and force_b - correction_b (docs/coupling.md, session 34).
+  Vec3 correction_b = Vec3::Zero();
 };
 
 // Outcome of Advance: ok, or where the state stopped making sense.
@@ -96,6 +100,7 @@ struct StepStatus {
   int node = -1;         // first offending node
   std::string reason;    // "non-finite position", "strain 1.3 > max_strain 1", ...
   // How the implicit schemes' Newton iterations went over this Advance (zero otherwise).
+  int substeps = 0;           // tether steps taken over the advance (explicit, rk4: with drag's)
   int newton_iterations = 0;  // linear solves, over all steps and stages
   int halvings = 0;           // steps (or half steps) redone as two halves
   int stalled_steps = 0;      // steps accepted with the Newton iteration not converged
@@ -289,6 +294,15 @@ class Tether {
   // damping effect. The coupling advisor's h damping/(L0 m_eff) (docs/coupling.md) and the
   // end-damping bound read it.
   double EndDamping() const;
+  // Quasi-static stiffness of the whole line at end B with end A held [N/m] (3 x 3, symmetric):
+  // the interior nodes in equilibrium under loads that do not move with them (weight,
+  // buoyancy), so that every segment carries the same force increment and the compliances add,
+  // K = (sum_j K_j^-1)^-1 with K_j = EA/L0 t t^T + T_j/l_j (I - t t^T), segment j's tangent
+  // stiffness along its direction t (axial) and across it (geometric), T_j = EA (l_j/L0 - 1).
+  // Zero where a segment is not in tension (the line then has no stiffness at its ends to first
+  // order). Bending, the seabed and the drag are left out, so it is never above the line's own.
+  // The consistent coupling's slow-mode correction reads it (docs/coupling.md, session 34).
+  Mat3 LineStiffness(const double* x) const;
 
   // The segment axial mode (docs/reference.md "Internal damping"): adjacent nodes moving in
   // opposite directions along the line, omega_n = (2/L0) sqrt(EA/mu) [rad/s], and its damping

@@ -824,7 +824,11 @@ Run Simulate(const Scene& s, double step, double duration = -1) {
       } else {
         // The step's work on the tether's ends (the reactions act on the sites; the tether
         // feels their opposite).
-        const double wa = -r.force_a.dot(xa - xa0), wb = -r.force_b.dot(xb - xb0);
+        // The line's own forces: the consistent coupling's slow-mode correction is the
+        // coupling's (EndReactions::correction_b), a numerical force on the body with its
+        // reaction at end A that the tether's nodes never feel.
+        const Vec3 fa = r.force_a + r.correction_b, fb = r.force_b - r.correction_b;
+        const double wa = -fa.dot(xa - xa0), wb = -fb.dot(xb - xb0);
         run.gross += std::abs(wa) + std::abs(wb);
         W += wa + wb;
         run.excess = std::max(run.excess, E - E0 - W);

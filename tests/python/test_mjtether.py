@@ -216,6 +216,8 @@ def test_tether_of_two_straight_lines_matches_the_closed_form():
         np.testing.assert_allclose(r["force_a"], [T_expected, 0, 0], rtol=1e-9, atol=1e-9)
         np.testing.assert_allclose(r["force_b"], [-T_expected, 0, 0], rtol=1e-9, atol=1e-9)
         assert r["tension_a"] == pytest.approx(T_expected, rel=1e-9)
+        # Fixed sites, no consistent coupling: no slow-mode correction in force_b.
+        np.testing.assert_array_equal(r["correction_b"], [0, 0, 0])
 
 
 def test_render_is_top_down_with_the_tension_colours():
