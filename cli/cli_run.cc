@@ -480,7 +480,7 @@ int Info(const std::string& path, const std::vector<std::string>& set) {
                     << " kg with its added mass) outweighing m_eff";
         }
         // SlowModeCorrection (plugin/plugin.cc): not on a winch.
-        if (!p.winch) std::cout << ", its damping of the body's bounce on the taut line corrected";
+        if (!p.winch) std::cout << ", its damping of slow modes on a taut line corrected";
       } else if (c.omega_h > 0) {
         std::cout << "; held end force";
       }
