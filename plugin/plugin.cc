@@ -1012,12 +1012,8 @@ double EndDampingRate(const mjModel* m, mjData* d, const AttachedTether& at, int
   Eigen::SelfAdjointEigenSolver<Mat3> ew(W);
   const Mat3 Wh = ew.eigenvectors() * ew.eigenvalues().cwiseMax(0).cwiseSqrt().asDiagonal() *
                   ew.eigenvectors().transpose();
-  const double lambda = Eigen::SelfAdjointEigenSolver<Mat3>(Wh * D * Wh, Eigen::EigenvaluesOnly)
-                            .eigenvalues()
-                            .maxCoeff();
-  if (lambda_D) {
-    *lambda_D = Eigen::SelfAdjointEigenSolver<Mat3>(D, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
-  }
+  const double lambda = LargestEigenvalue(Wh * D * Wh);
+  if (lambda_D) *lambda_D = LargestEigenvalue(D);
   if (speed) {
     const Vec3 current = t.env().water.current;  // (a profile: its value at z = 0)
     *speed = (es.vel - current).norm();
@@ -2023,7 +2019,7 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
         mj_factorM(m, d);
       }
       const Mat3 W = SiteInverseMass(m, d, at.site[end], jac.data());
-      const double lambda = Eigen::SelfAdjointEigenSolver<Mat3>(W).eigenvalues().maxCoeff();
+      const double lambda = LargestEigenvalue(W);
       CouplingLimit& c = at.limit[end];
       c.body = at.body[end];
       c.k_end = t.EndStiffness();

@@ -24,6 +24,25 @@ namespace {
 
 using LightVehicle = testing::MuJoCoFixture;
 
+// A free body at (x, 0, 0) with its site "hook", on a 10 m tether "t" (diameter 0.01 m) from
+// the world's site "anchor" at the origin, no water; the scene of the momentum, heavy node and
+// bounce tests below. step [s], gravity [m/s^2] along x, mass_per_length [kg/m], EA [N], x [m],
+// mass [kg], inertia [kg m^2] (each principal moment).
+std::string AnchoredBodyXml(const std::string& step, const std::string& gravity, int segments,
+                            const std::string& mass_per_length, const std::string& EA,
+                            const std::string& integrator, const std::string& x,
+                            const std::string& mass, const std::string& inertia) {
+  return R"(<mujoco><option timestep=")" + step + R"(" gravity=")" + gravity + R"( 0 0"/>
+<custom><text name="tether:t" data="ends=anchor,hook length=10 segments=)" +
+         std::to_string(segments) + " diameter=0.01 mass_per_length=" + mass_per_length +
+         " EA=" + EA + " integrator=" + integrator + R"("/></custom>
+<worldbody><site name="anchor"/>
+<body name="v" pos=")" + x + R"( 0 0"><freejoint/>
+<inertial pos="0 0 0" mass=")" + mass + R"(" diaginertia=")" + inertia + " " + inertia + " " +
+         inertia + R"("/><site name="hook"/></body>
+</worldbody></mujoco>)";
+}
+
 // explicit's consistent coupling (session 27): end node B, carrying a body, ends each advance
 // where MuJoCo's Euler step will put the body, x_B(t) + dt v_B(t + dt), whatever the substep
 // count, so that the plugin's move of the node onto the site at the next call changes nothing
@@ -380,14 +399,8 @@ TEST_F(LightVehicle, MomentumChangeIsTheAnchorsImpulse) {
     // explicit at 1 ms (omega h 1.4; at 2 ms, 2.8, it is refused): the consistent coupling in
     // its substeps, end A's reported force their mean.
     const char* step = std::string(integrator) == "explicit" ? "0.001" : "0.002";
-    const std::string xml = std::string(R"(<mujoco><option timestep=")") + step +
-                            R"(" gravity="0 0 0"/>
-<custom><text name="tether:t" data="ends=anchor,hook length=10 segments=10 diameter=0.01
-  mass_per_length=0.05 EA=1e7 integrator=)" + integrator + R"("/></custom>
-<worldbody><site name="anchor"/>
-<body name="v" pos="10.001 0 0"><freejoint/>
-<inertial pos="0 0 0" mass="5" diaginertia="0.1 0.1 0.1"/><site name="hook"/></body>
-</worldbody></mujoco>)";
+    const std::string xml =
+        AnchoredBodyXml(step, "0", 10, "0.05", "1e7", integrator, "10.001", "5", "0.1");
     mjModel* m = Load(xml, "momentum.xml");
     ASSERT_NE(m, nullptr);
     // End node B is not counted (session 11, s11coup; explicit since session 32): its inertia
@@ -423,13 +436,8 @@ TEST_F(LightVehicle, MomentumChangeIsTheAnchorsImpulse) {
 // printout; with the held force (before) the mismatch was the node's lost momentum.
 TEST_F(LightVehicle, HeavyEndNodeIsCarriedByTheBodyAtAnyOmegaH) {
   for (const char* integrator : {"implicit", "bdf2", "implicit2", "explicit"}) {
-    const std::string xml = std::string(R"(<mujoco><option timestep="0.002" gravity="0 0 0"/>
-<custom><text name="tether:t" data="ends=anchor,hook length=10 segments=10 diameter=0.01
-  mass_per_length=1 EA=5000 integrator=)") + integrator + R"("/></custom>
-<worldbody><site name="anchor"/>
-<body name="v" pos="10.001 0 0"><freejoint/>
-<inertial pos="0 0 0" mass="0.2" diaginertia="0.01 0.01 0.01"/><site name="hook"/></body>
-</worldbody></mujoco>)";
+    const std::string xml =
+        AnchoredBodyXml("0.002", "0", 10, "1", "5000", integrator, "10.001", "0.2", "0.01");
     mjModel* m = Load(xml, "heavy_node.xml");
     ASSERT_NE(m, nullptr);
     const CouplingLimit c = GetCouplingLimit(m, 0, 1);
@@ -469,14 +477,8 @@ TEST_F(LightVehicle, HeavyEndNodeIsCarriedByTheBodyAtAnyOmegaH) {
 TEST_F(LightVehicle, BounceOnATautLineIsNotDampedByTheConsistentCoupling) {
   for (const char* integrator : {"implicit", "bdf2", "implicit2", "explicit"}) {
     auto amplitude = [&](const char* step, bool* consistent) -> double {
-      const std::string xml = std::string(R"(<mujoco><option timestep=")") + step +
-                              R"(" gravity="100 0 0"/>
-<custom><text name="tether:t" data="ends=anchor,hook length=10 segments=180 diameter=0.01
-  mass_per_length=0.05 EA=1e7 integrator=)" + integrator + R"("/></custom>
-<worldbody><site name="anchor"/>
-<body name="v" pos="10.0867 0 0"><freejoint/>
-<inertial pos="0 0 0" mass="667" diaginertia="10 10 10"/><site name="hook"/></body>
-</worldbody></mujoco>)";
+      const std::string xml =
+          AnchoredBodyXml(step, "100", 180, "0.05", "1e7", integrator, "10.0867", "667", "10");
       mjModel* m = Load(xml, "bounce.xml");
       if (!m) return NAN;
       *consistent = GetCouplingLimit(m, 0, 1).consistent;
