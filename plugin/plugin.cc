@@ -521,7 +521,9 @@ void WatchSnaps(const AttachedTether& at, const double* x, const double* v, doub
 // quasi-static stiffness at end B (Tether::LineStiffness), far below the end segment's EA/L0
 // on more than a few segments, so the fast body-end mode stays damped as before.
 // Only on a slow mode, kappa z^2 <= kSlowModeMax (z <= 0.1 with backward Euler, 0.14 with the
-// others): there a step's damping is small but adds up over many steps, while symplectic
+// others), each mode of W K apart (since session 35; session 34 took the bound h^2
+// lambda_max(W) lambda_max(K) for all three, and a line's fast bounce along it then switched
+// off the correction of the vehicle's slow swing across it): there a step's damping is small but adds up over many steps, while symplectic
 // Euler's own energy error, which the correction brings back, is O(z) (at z = 0.45 a free body
 // on a taut line gained 7.5% of its energy within a bounce, the held force 9%, where the
 // dissipative step never rises: CouplingExplicit.FreeBodyOnTautTetherGainsNoEnergy), and the
@@ -533,7 +535,9 @@ void WatchSnaps(const AttachedTether& at, const double* x, const double* v, doub
 // bouncing at z = 0.077: 51% of its amplitude left after 0.5 s with implicit, 72% with
 // implicit2, without this; within 0.06% of the fine step's with it). Scene fuzzer seed 11700
 // (implicit2, a 3.2 t vehicle thrust against a taut 5.8 m line): 7.6 cm off its fine-step
-// self, the swing's amplitude 13% low; 0.6 cm with this.
+// self, the swing's amplitude 13% low; 0.6 cm with this. Mode by mode:
+// LightVehicle.SwingAcrossATautLineIsNotDampedWhereItsBounceIsFast (a swing at z^2 = 4e-4 on a
+// line whose bounce has z^2 = 0.08: 16% low after 2 s with the bound, within 0.5% now).
 constexpr double kSlowModeMax = 0.01;
 double LargestEigenvalue(const Mat3& A) {
   return Eigen::SelfAdjointEigenSolver<Mat3>(A, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
@@ -562,13 +566,29 @@ double SlowModeKappa(Integrator scheme, int substeps) {
 // The tether's step does not see the correction: the model step is v+ = v_B+ + h W K_c v, v_B+
 // the uncorrected one, and K_c = kappa K/(1 + kappa z^2) per mode restores symplectic Euler's
 // energy (without the inverse the bounce of the test grew 20% in 0.5 s with implicit).
+// Mode by mode (session 35): with S = W^1/2 K W^1/2 = Q diag(lambda_i) Q^T, z_i^2 = h^2
+// lambda_i, the correction is kappa h W^-1/2 Q diag(g_i) Q^T W^-1/2 (v_B - v_A), g_i =
+// lambda_i/(1 + kappa z_i^2) on a slow mode (kappa z_i^2 <= kSlowModeMax) and 0 on the others;
+// with every mode slow it is the expression above. A taut line's stiffness along it (EA/L) is
+// far above its stiffness across it (T/l): the vehicle's swing is slow where its bounce is not.
 Vec3 SlowModeCorrection(const Mat3& K, const Mat3& W, const Ends& now, double h, double kappa) {
   if (K.isZero(0) || !(kappa > 0)) return Vec3::Zero();
-  // z^2 <= h^2 lambda_max(W) lambda_max(K): the bound errs towards no correction.
-  const double z2 = h * h * LargestEigenvalue(W) * LargestEigenvalue(K);
-  if (kappa * z2 > kSlowModeMax) return Vec3::Zero();
-  const Mat3 KW = (kappa * h * h) * K * W;  // K (I + c W K)^-1 = (I + c K W)^-1 K
-  return (kappa * h) * ((Mat3::Identity() + KW).inverse() * (K * (now.b.vel - now.a.vel)));
+  const Eigen::SelfAdjointEigenSolver<Mat3> ew(W);
+  if (!(ew.eigenvalues().minCoeff() > 0)) return Vec3::Zero();
+  const Vec3 root = ew.eigenvalues().cwiseSqrt();
+  const Mat3& U = ew.eigenvectors();
+  const Mat3 W_half = U * root.asDiagonal() * U.transpose();                    // W^1/2
+  const Mat3 W_minus_half = U * root.cwiseInverse().asDiagonal() * U.transpose();  // W^-1/2
+  const Eigen::SelfAdjointEigenSolver<Mat3> es(W_half * K * W_half);
+  Vec3 g;
+  for (int i = 0; i < 3; ++i) {
+    const double lambda = std::max(es.eigenvalues()[i], 0.0);  // [1/s^2] the mode's omega^2
+    const double kz2 = kappa * h * h * lambda;
+    g[i] = kz2 <= kSlowModeMax ? lambda / (1 + kz2) : 0;
+  }
+  const Mat3& Q = es.eigenvectors();
+  return (kappa * h) * (W_minus_half * (Q * g.asDiagonal() * Q.transpose()) * W_minus_half *
+                        (now.b.vel - now.a.vel));
 }
 
 // A tether with the consistent coupling at end B (AttachedTether::lead; docs/coupling.md).
