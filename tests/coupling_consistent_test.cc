@@ -22,7 +22,36 @@
 namespace mjtether {
 namespace {
 
-using LightVehicle = testing::MuJoCoFixture;
+// The oscillation of the body of AnchoredBodyXml (below): the half range of qpos[axis] (its
+// position along x, y or z [m]) over [from, until] s, whether the scene took the consistent
+// coupling, and the largest slow-mode correction on the way [N]; amplitude NAN where the scene
+// does not load or diverges.
+struct Oscillation {
+  double amplitude = NAN;
+  bool consistent = false;
+  double correction = 0;
+};
+
+class LightVehicle : public testing::MuJoCoFixture {
+ protected:
+  Oscillation Oscillate(const std::string& xml, const char* name, int axis, double from,
+                        double until) {
+    Oscillation o;
+    mjModel* m = Load(xml, name);
+    if (!m) return o;
+    o.consistent = GetCouplingLimit(m, 0, 1).consistent;
+    mjData* d = Make(m);
+    double lo = INFINITY, hi = -INFINITY;
+    while (d->time < until) {
+      Step(m, d);
+      if (CheckDivergence(m, d)) return o;
+      o.correction = std::max(o.correction, GetReactions(m, d, 0).correction_b.norm());
+      if (d->time >= from) lo = std::min(lo, d->qpos[axis]), hi = std::max(hi, d->qpos[axis]);
+    }
+    o.amplitude = (hi - lo) / 2;
+    return o;
+  }
+};
 
 // A free body at pos ("x y z") with its site "hook", on a 10 m tether "t" (diameter 0.01 m) from
 // the world's site "anchor" at the origin, no water; the scene of the momentum, heavy node and
@@ -476,29 +505,18 @@ TEST_F(LightVehicle, HeavyEndNodeIsCarriedByTheBodyAtAnyOmegaH) {
 // 39% high. The 0.25% tells the exact correction from the one without the inverse.
 TEST_F(LightVehicle, BounceOnATautLineIsNotDampedByTheConsistentCoupling) {
   for (const char* integrator : {"implicit", "bdf2", "implicit2", "explicit"}) {
-    auto amplitude = [&](const char* step, bool* consistent) -> double {
-      const std::string xml =
-          AnchoredBodyXml(step, "100", 180, "0.05", "1e7", integrator, "10.0867 0 0", "667", "10");
-      mjModel* m = Load(xml, "bounce.xml");
-      if (!m) return NAN;
-      *consistent = GetCouplingLimit(m, 0, 1).consistent;
-      mjData* d = Make(m);
-      double lo = INFINITY, hi = -INFINITY;
-      while (d->time < 0.5) {
-        Step(m, d);
-        if (CheckDivergence(m, d)) return NAN;
-        if (d->time >= 0.4) lo = std::min(lo, d->qpos[0]), hi = std::max(hi, d->qpos[0]);
-      }
-      return (hi - lo) / 2;
+    auto run = [&](const char* step) {
+      return Oscillate(
+          AnchoredBodyXml(step, "100", 180, "0.05", "1e7", integrator, "10.0867 0 0", "667", "10"),
+          "bounce.xml", 0, 0.4, 0.5);
     };
-    bool coarse_consistent = false, fine_consistent = true;
-    const double coarse = amplitude("0.002", &coarse_consistent);
-    const double fine = amplitude("0.0001", &fine_consistent);
+    const Oscillation c = run("0.002"), f = run("0.0001");
+    const double coarse = c.amplitude, fine = f.amplitude;
     std::printf("%s: bounce amplitude over 0.4-0.5 s %.4f mm at 2 ms, %.4f mm at 0.1 ms\n",
                 integrator, 1e3 * coarse, 1e3 * fine);
-    EXPECT_TRUE(coarse_consistent) << integrator;
-    EXPECT_FALSE(fine_consistent) << integrator;  // the held force: the reference
-    EXPECT_GT(fine, 0.018) << integrator;         // the bounce kept its 20 mm
+    EXPECT_TRUE(c.consistent) << integrator;
+    EXPECT_FALSE(f.consistent) << integrator;  // the held force: the reference
+    EXPECT_GT(fine, 0.018) << integrator;      // the bounce kept its 20 mm
     EXPECT_NEAR(coarse, fine, 0.0025 * fine) << integrator;
   }
 }
@@ -521,34 +539,20 @@ TEST_F(LightVehicle, BounceOnATautLineIsNotDampedByTheConsistentCoupling) {
 // moved 246 scenes: 63 closer to their fine step, 183 further (docs/coupling.md, session 35).
 TEST_F(LightVehicle, SlowModeCorrectionAlsoHoldsTheBounceOfALineHeavierThanTheBody) {
   for (const char* integrator : {"implicit", "bdf2", "implicit2", "explicit"}) {
-    auto amplitude = [&](const char* step, bool* consistent, double* correction) -> double {
-      const std::string xml =
-          AnchoredBodyXml(step, "100", 180, "1", "1e5", integrator, "10.095 0 0", "5", "0.1");
-      mjModel* m = Load(xml, "heavy_line.xml");
-      if (!m) return NAN;
-      *consistent = GetCouplingLimit(m, 0, 1).consistent;
-      mjData* d = Make(m);
-      double lo = INFINITY, hi = -INFINITY;
-      *correction = 0;
-      while (d->time < 0.5) {
-        Step(m, d);
-        if (CheckDivergence(m, d)) return NAN;
-        *correction = std::max(*correction, GetReactions(m, d, 0).correction_b.norm());
-        if (d->time >= 0.4) lo = std::min(lo, d->qpos[0]), hi = std::max(hi, d->qpos[0]);
-      }
-      return (hi - lo) / 2;
+    auto run = [&](const char* step) {
+      return Oscillate(
+          AnchoredBodyXml(step, "100", 180, "1", "1e5", integrator, "10.095 0 0", "5", "0.1"),
+          "heavy_line.xml", 0, 0.4, 0.5);
     };
-    bool coarse_consistent = false, fine_consistent = true;
-    double coarse_correction = 1, fine_correction = 1;
-    const double coarse = amplitude("0.002", &coarse_consistent, &coarse_correction);
-    const double fine = amplitude("0.0001", &fine_consistent, &fine_correction);
+    const Oscillation c = run("0.002"), f = run("0.0001");
+    const double coarse = c.amplitude, fine = f.amplitude;
     std::printf("%s: heavy line, bounce amplitude over 0.4-0.5 s %.4f mm at 2 ms, %.4f mm at "
                 "0.1 ms; largest correction %.3g N\n",
-                integrator, 1e3 * coarse, 1e3 * fine, coarse_correction);
-    EXPECT_TRUE(coarse_consistent) << integrator;
-    EXPECT_FALSE(fine_consistent) << integrator;
-    EXPECT_GT(coarse_correction, 1) << integrator;  // [N] (8-16 N measured)
-    EXPECT_GT(fine, 0.0085) << integrator;            // the bounce (9-9.8 mm measured)
+                integrator, 1e3 * coarse, 1e3 * fine, c.correction);
+    EXPECT_TRUE(c.consistent) << integrator;
+    EXPECT_FALSE(f.consistent) << integrator;
+    EXPECT_GT(c.correction, 1) << integrator;  // [N] (8-16 N measured)
+    EXPECT_GT(fine, 0.0085) << integrator;     // the bounce (9-9.8 mm measured)
     EXPECT_NEAR(coarse, fine, 0.2 * fine) << integrator;
   }
 }
@@ -566,28 +570,17 @@ TEST_F(LightVehicle, SlowModeCorrectionAlsoHoldsTheBounceOfALineHeavierThanTheBo
 // 15.6% (bdf2), 8.1% (implicit2, explicit) (docs/coupling.md, session 35).
 TEST_F(LightVehicle, SwingAcrossATautLineIsNotDampedWhereItsBounceIsFast) {
   for (const char* integrator : {"implicit", "bdf2", "implicit2", "explicit"}) {
-    auto amplitude = [&](const char* step, bool* consistent) -> double {
-      const std::string xml = AnchoredBodyXml(step, "1000", 40, "0.05", "1e6", integrator,
-                                              "10.000125 1 0", "5", "0.1");
-      mjModel* m = Load(xml, "swing.xml");
-      if (!m) return NAN;
-      *consistent = GetCouplingLimit(m, 0, 1).consistent;
-      mjData* d = Make(m);
-      double lo = INFINITY, hi = -INFINITY;
-      while (d->time < 2) {
-        Step(m, d);
-        if (CheckDivergence(m, d)) return NAN;
-        if (d->time >= 1.4) lo = std::min(lo, d->qpos[1]), hi = std::max(hi, d->qpos[1]);
-      }
-      return (hi - lo) / 2;
+    auto run = [&](const char* step) {
+      return Oscillate(AnchoredBodyXml(step, "1000", 40, "0.05", "1e6", integrator,
+                                       "10.000125 1 0", "5", "0.1"),
+                       "swing.xml", 1, 1.4, 2);
     };
-    bool coarse_consistent = false, fine_consistent = true;
-    const double coarse = amplitude("0.002", &coarse_consistent);
-    const double fine = amplitude("0.0001", &fine_consistent);
+    const Oscillation c = run("0.002"), f = run("0.0001");
+    const double coarse = c.amplitude, fine = f.amplitude;
     std::printf("%s: swing amplitude over 1.4-2 s %.4f m at 2 ms, %.4f m at 0.1 ms\n", integrator,
                 coarse, fine);
-    EXPECT_TRUE(coarse_consistent) << integrator;
-    EXPECT_FALSE(fine_consistent) << integrator;
+    EXPECT_TRUE(c.consistent) << integrator;
+    EXPECT_FALSE(f.consistent) << integrator;
     EXPECT_GT(fine, 0.9) << integrator;  // the swing kept its 1 m
     EXPECT_NEAR(coarse, fine, 0.01 * fine) << integrator;
   }
