@@ -521,16 +521,16 @@ void WatchSnaps(const AttachedTether& at, const double* x, const double* v, doub
 // quasi-static stiffness at end B (Tether::LineStiffness), far below the end segment's EA/L0
 // on more than a few segments, so the fast body-end mode stays damped as before.
 // Only on a slow mode, kappa z^2 <= kSlowModeMax (z <= 0.1 with backward Euler, 0.14 with the
-// others), each mode of W K apart (since session 35; session 34 took the bound h^2
-// lambda_max(W) lambda_max(K) for all three, and a line's fast bounce along it then switched
-// off the correction of the vehicle's slow swing across it): there a step's damping is small but adds up over many steps, while symplectic
-// Euler's own energy error, which the correction brings back, is O(z) (at z = 0.45 a free body
-// on a taut line gained 7.5% of its energy within a bounce, the held force 9%, where the
-// dissipative step never rises: CouplingExplicit.FreeBodyOnTautTetherGainsNoEnergy), and the
-// model stops holding (implicit2's spectral radius at z = 4 is 0.82, the model's 0.33). None
+// others), each mode of W K apart (since session 35; session 34 took the bound h^2 lambda_max(W)
+// lambda_max(K) for all three, and a line's fast bounce along it then switched off the correction
+// of the vehicle's slow swing across it): there a step's damping is small but adds up over many
+// steps, while symplectic Euler's own energy error, which the correction brings back, is O(z) (at z
+// = 0.45 a free body on a taut line gained 7.5% of its energy within a bounce, the held force 9%,
+// where the dissipative step never rises: CouplingExplicit.FreeBodyOnTautTetherGainsNoEnergy), and
+// the model stops holding (implicit2's spectral radius at z = 4 is 0.82, the model's 0.33). None
 // where a segment is slack at the step's start or end (no first-order stiffness, or a snap or
-// release within the step), where end node B outweighs the body (the line is no light spring
-// then) or on a winch (its length changes within the step).
+// release within the step), where end node B outweighs the body (the line is no light spring then)
+// or on a winch (its length changes within the step).
 // Test: LightVehicle.BounceOnATautLineIsNotDampedByTheConsistentCoupling (a 667 kg body
 // bouncing at z = 0.077: 51% of its amplitude left after 0.5 s with implicit, 72% with
 // implicit2, without this; within 0.06% of the fine step's with it). Scene fuzzer seed 11700
@@ -541,6 +541,14 @@ void WatchSnaps(const AttachedTether& at, const double* x, const double* v, doub
 constexpr double kSlowModeMax = 0.01;
 double LargestEigenvalue(const Mat3& A) {
   return Eigen::SelfAdjointEigenSolver<Mat3>(A, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
+}
+// W^1/2 (inverse: W^-1/2) of a symmetric positive semidefinite 3 x 3 matrix from its
+// eigensolver, U diag(sqrt(w_i)) U^T, round-off below zero clipped to 0 (W^-1/2 needs every
+// w_i > 0). The end-damping bound's and the slow-mode correction's mass scaling.
+Mat3 SquareRoot(const Eigen::SelfAdjointEigenSolver<Mat3>& e, bool inverse = false) {
+  Vec3 root = e.eigenvalues().cwiseMax(0).cwiseSqrt();
+  if (inverse) root = root.cwiseInverse();
+  return e.eigenvectors() * root.asDiagonal() * e.eigenvectors().transpose();
 }
 // kappa over an advance of n tether steps (StepStatus::substeps). The body's force is end node
 // B's mean force over them, the node on MuJoCo's Euler path x + s v+: backward Euler takes each
@@ -575,10 +583,7 @@ Vec3 SlowModeCorrection(const Mat3& K, const Mat3& W, const Ends& now, double h,
   if (K.isZero(0) || !(kappa > 0)) return Vec3::Zero();
   const Eigen::SelfAdjointEigenSolver<Mat3> ew(W);
   if (!(ew.eigenvalues().minCoeff() > 0)) return Vec3::Zero();
-  const Vec3 root = ew.eigenvalues().cwiseSqrt();
-  const Mat3& U = ew.eigenvectors();
-  const Mat3 W_half = U * root.asDiagonal() * U.transpose();                    // W^1/2
-  const Mat3 W_minus_half = U * root.cwiseInverse().asDiagonal() * U.transpose();  // W^-1/2
+  const Mat3 W_half = SquareRoot(ew), W_minus_half = SquareRoot(ew, true);
   const Eigen::SelfAdjointEigenSolver<Mat3> es(W_half * K * W_half);
   Vec3 g;
   for (int i = 0; i < 3; ++i) {
@@ -1029,9 +1034,7 @@ double EndDampingRate(const mjModel* m, mjData* d, const AttachedTether& at, int
   }
   const Mat3 D = -0.5 * (J + J.transpose());
   const Mat3 W = SiteInverseMass(m, d, at.site[end], jac);
-  Eigen::SelfAdjointEigenSolver<Mat3> ew(W);
-  const Mat3 Wh = ew.eigenvectors() * ew.eigenvalues().cwiseMax(0).cwiseSqrt().asDiagonal() *
-                  ew.eigenvectors().transpose();
+  const Mat3 Wh = SquareRoot(Eigen::SelfAdjointEigenSolver<Mat3>(W));
   const double lambda = LargestEigenvalue(Wh * D * Wh);
   if (lambda_D) *lambda_D = LargestEigenvalue(D);
   if (speed) {

@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "coupling_scene.h"
@@ -50,6 +51,13 @@ class LightVehicle : public testing::MuJoCoFixture {
     }
     o.amplitude = (hi - lo) / 2;
     return o;
+  }
+  // The same scene at the 2 ms step and at 0.1 ms (the reference), xml(step) giving its MJCF.
+  template <typename Xml>
+  std::pair<Oscillation, Oscillation> CoarseAndFine(Xml xml, const char* name, int axis,
+                                                    double from, double until) {
+    return {Oscillate(xml("0.002"), name, axis, from, until),
+            Oscillate(xml("0.0001"), name, axis, from, until)};
   }
 };
 
@@ -505,12 +513,12 @@ TEST_F(LightVehicle, HeavyEndNodeIsCarriedByTheBodyAtAnyOmegaH) {
 // 39% high. The 0.25% tells the exact correction from the one without the inverse.
 TEST_F(LightVehicle, BounceOnATautLineIsNotDampedByTheConsistentCoupling) {
   for (const char* integrator : {"implicit", "bdf2", "implicit2", "explicit"}) {
-    auto run = [&](const char* step) {
-      return Oscillate(
-          AnchoredBodyXml(step, "100", 180, "0.05", "1e7", integrator, "10.0867 0 0", "667", "10"),
-          "bounce.xml", 0, 0.4, 0.5);
-    };
-    const Oscillation c = run("0.002"), f = run("0.0001");
+    const auto [c, f] = CoarseAndFine(
+        [&](const char* step) {
+          return AnchoredBodyXml(step, "100", 180, "0.05", "1e7", integrator, "10.0867 0 0",
+                                 "667", "10");
+        },
+        "bounce.xml", 0, 0.4, 0.5);
     const double coarse = c.amplitude, fine = f.amplitude;
     std::printf("%s: bounce amplitude over 0.4-0.5 s %.4f mm at 2 ms, %.4f mm at 0.1 ms\n",
                 integrator, 1e3 * coarse, 1e3 * fine);
@@ -539,12 +547,12 @@ TEST_F(LightVehicle, BounceOnATautLineIsNotDampedByTheConsistentCoupling) {
 // moved 246 scenes: 63 closer to their fine step, 183 further (docs/coupling.md, session 35).
 TEST_F(LightVehicle, SlowModeCorrectionAlsoHoldsTheBounceOfALineHeavierThanTheBody) {
   for (const char* integrator : {"implicit", "bdf2", "implicit2", "explicit"}) {
-    auto run = [&](const char* step) {
-      return Oscillate(
-          AnchoredBodyXml(step, "100", 180, "1", "1e5", integrator, "10.095 0 0", "5", "0.1"),
-          "heavy_line.xml", 0, 0.4, 0.5);
-    };
-    const Oscillation c = run("0.002"), f = run("0.0001");
+    const auto [c, f] = CoarseAndFine(
+        [&](const char* step) {
+          return AnchoredBodyXml(step, "100", 180, "1", "1e5", integrator, "10.095 0 0", "5",
+                                 "0.1");
+        },
+        "heavy_line.xml", 0, 0.4, 0.5);
     const double coarse = c.amplitude, fine = f.amplitude;
     std::printf("%s: heavy line, bounce amplitude over 0.4-0.5 s %.4f mm at 2 ms, %.4f mm at "
                 "0.1 ms; largest correction %.3g N\n",
@@ -570,12 +578,12 @@ TEST_F(LightVehicle, SlowModeCorrectionAlsoHoldsTheBounceOfALineHeavierThanTheBo
 // 15.6% (bdf2), 8.1% (implicit2, explicit) (docs/coupling.md, session 35).
 TEST_F(LightVehicle, SwingAcrossATautLineIsNotDampedWhereItsBounceIsFast) {
   for (const char* integrator : {"implicit", "bdf2", "implicit2", "explicit"}) {
-    auto run = [&](const char* step) {
-      return Oscillate(AnchoredBodyXml(step, "1000", 40, "0.05", "1e6", integrator,
-                                       "10.000125 1 0", "5", "0.1"),
-                       "swing.xml", 1, 1.4, 2);
-    };
-    const Oscillation c = run("0.002"), f = run("0.0001");
+    const auto [c, f] = CoarseAndFine(
+        [&](const char* step) {
+          return AnchoredBodyXml(step, "1000", 40, "0.05", "1e6", integrator, "10.000125 1 0",
+                                 "5", "0.1");
+        },
+        "swing.xml", 1, 1.4, 2);
     const double coarse = c.amplitude, fine = f.amplitude;
     std::printf("%s: swing amplitude over 1.4-2 s %.4f m at 2 ms, %.4f m at 0.1 ms\n", integrator,
                 coarse, fine);

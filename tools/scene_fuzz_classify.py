@@ -109,6 +109,21 @@ def print_bands(seen):
                   f"{c['refused']:7d}  {c['diverged']:8d}  {c['warned']:8d}")
 
 
+def read_log(path, lo=0, hi=float("inf")):
+    """(seed, draw) -> the LINE match of its first line in a verbose log, seeds lo..hi (the
+    known list's summary at the end repeats some lines). Also tools/scene_fuzz_compare.py's."""
+    seen = OrderedDict()
+    for raw in open(path, errors="replace"):
+        m = LINE.match(raw.strip())
+        if not m:
+            continue
+        seed, draw = int(m.group(1)), int(m.group(3) or 2)
+        if (seed, draw) in seen or not lo <= seed <= hi:
+            continue
+        seen[(seed, draw)] = m
+    return seen
+
+
 def main():
     counts_only = "--counts" in sys.argv
     bands = "--bands" in sys.argv
@@ -119,15 +134,7 @@ def main():
         lo, hi = (int(x) for x in args[i + 1].split("-"))
         del args[i:i + 2]
     path = [a for a in args if not a.startswith("--")][0]
-    seen = OrderedDict()
-    for raw in open(path):
-        m = LINE.match(raw.strip())
-        if not m:
-            continue
-        seed, draw = int(m.group(1)), int(m.group(3) or 2)
-        if (seed, draw) in seen or not lo <= seed <= hi:
-            continue
-        seen[(seed, draw)] = m
+    seen = read_log(path, lo, hi)
     if bands:
         print_bands(seen)
         return

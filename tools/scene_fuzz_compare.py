@@ -19,29 +19,25 @@ import collections
 import re
 import statistics
 
-# "seed 123 [implicit, N=4, ...]: pass: agrees with 10x smaller step: position ..."
-LINE = re.compile(r"seed (\d+)( draw=\d+)? \[(\w+),(.*?)\]: (pass|FAIL): ([^:]+)")
-FIGURES = re.compile(r": position ([\d.e+-]+) m \(tol ([\d.e+-]+)\), tension ([\d.e+-]+) vs "
+from scene_fuzz_classify import read_log  # the log's line format, read once (same directory)
+
+FIGURES = re.compile(r"position ([\d.e+-]+) m \(tol ([\d.e+-]+)\), tension ([\d.e+-]+) vs "
                      r"([\d.e+-]+) N \(tol ([\d.e+-]+)\)")
-THRUST = re.compile(r"thrust/holds=([\d.e+-]+)")
 
 
-def load(path):
-  """Seed -> (integrator, outcome, kind, thrust, figures) for draw 0; the first line of a seed
-  (the known list repeats some lines at the end)."""
+def load(path, first, last):
+  """Seed -> (integrator, outcome, kind, thrust, figures) of the current draw (2), seeds
+  first..last; figures: (position error/tolerance, tension error/tolerance) or None."""
   scenes = {}
-  for line in open(path, errors="replace"):
-    m = LINE.match(line)
-    if not m or m.group(2) or int(m.group(1)) in scenes:
+  for (seed, draw), m in read_log(path, first, last).items():
+    if draw != 2:
       continue
-    f = FIGURES.search(line)
+    f = FIGURES.search(m.group(13))
     figures = None
     if f:
       pos, pos_tol, t, t_ref, t_tol = map(float, f.groups())
       figures = (pos / pos_tol, abs(t - t_ref) / t_tol)
-    t = THRUST.search(m.group(4))
-    scenes[int(m.group(1))] = (m.group(3), m.group(5), m.group(6).strip(),
-                               float(t.group(1)) if t else 0.0, figures)
+    scenes[seed] = (m.group(4), m.group(11), m.group(12).strip(), float(m.group(10)), figures)
   return scenes
 
 
@@ -56,8 +52,8 @@ def main():
   ap.add_argument("--first", type=int, default=0, help="first seed counted (default: all)")
   ap.add_argument("--last", type=int, default=1 << 62, help="last seed counted")
   args = ap.parse_args()
-  a, b = load(args.before), load(args.after)
-  seeds = sorted(s for s in a if s in b and args.first <= s <= args.last)
+  a, b = load(args.before, args.first, args.last), load(args.after, args.first, args.last)
+  seeds = sorted(s for s in a if s in b)
   fa = [s for s in seeds if a[s][1] == "FAIL"]
   fb = [s for s in seeds if b[s][1] == "FAIL"]
   print(f"{len(seeds)} seeds in both logs; failures before {len(fa)}, after {len(fb)}")
