@@ -1828,8 +1828,20 @@ std::string Diagnose(const mjModel* m, const mjData* d, const Environment& env,
         << " s, more than half of max_strain x the segment length "
         << p.max_strain * t.rest_segment_length()
         << " m: that motion is too fast for the step; reduce <option timestep> below "
-        << StepAtMost(0.5 * p.max_strain * t.rest_segment_length() / vel[end].norm())
-        << " s or slow the motion";
+        << StepAtMost(0.5 * p.max_strain * t.rest_segment_length() / vel[end].norm()) << " s";
+      // A free body that nothing prescribes and no schedule pushes was thrown by the tether
+      // (LightVehicle.ThrownFreeBodyIsToldWhatThrewIt: explicit at coupling omega h 1.64 on an
+      // undamped line, the body thrown at 78 m/s; it ran with damping_ratio=1 or implicit, and
+      // "slow the motion" named nothing the user could slow).
+      const bool thrown = at.body[end] > 0 && !at.mocap[end];
+      if (thrown) {
+        s << "; nothing prescribes body '" << body_name(end)
+          << "', so the tether (or a force on it) threw it: where the load warnings say the "
+             "coupling may chatter use integrator=implicit or bdf2, and where a snap rang the "
+             "line declare damping_ratio=1";
+      } else {
+        s << " or slow the motion";
+      }
       return s.str();
     }
   }
