@@ -1732,6 +1732,7 @@ std::string Diagnose(const mjModel* m, const mjData* d, const Environment& env,
   auto moved_by_motion = [&](int end) {
     return at.mocap[end] && mj_name2id(m, mjOBJ_TEXT, ("motion:" + body_name(end)).c_str()) >= 0;
   };
+  auto free_body = [&](int end) { return at.body[end] > 0 && !at.mocap[end]; };
   // Ends pulled apart. The strain is not uniform along a pulled line: where it first crosses
   // max_strain, the mean strain span / length - 1 can still be below it by the strain spread
   // along the line (issue 11: a mocap end pulled at 0.5 m/s diverged at a mean strain of
@@ -1807,7 +1808,7 @@ std::string Diagnose(const mjModel* m, const mjData* d, const Environment& env,
       }
     }
     for (int end = 0; end < 2; ++end) {
-      if (at.body[end] > 0 && !at.mocap[end]) {
+      if (free_body(end)) {
         s << ", by forces on body '" << body_name(end) << "' larger than EA x max_strain = "
           << holds << " N; lengthen the tether or reduce them";
         return s.str();
@@ -1829,11 +1830,12 @@ std::string Diagnose(const mjModel* m, const mjData* d, const Environment& env,
         << p.max_strain * t.rest_segment_length()
         << " m: that motion is too fast for the step; reduce <option timestep> below "
         << StepAtMost(0.5 * p.max_strain * t.rest_segment_length() / vel[end].norm()) << " s";
-      // A free body that nothing prescribes and no schedule pushes was thrown by the tether
-      // (LightVehicle.ThrownFreeBodyIsToldWhatThrewIt: explicit at coupling omega h 1.64 on an
+      // A free body that nothing prescribes (a schedule beyond what the tether holds was named
+      // above) was thrown by the tether or a force on it. Test:
+      // LightVehicle.ThrownFreeBodyIsToldWhatThrewIt (explicit at coupling omega h 1.64 on an
       // undamped line, the body thrown at 78 m/s; it ran with damping_ratio=1 or implicit, and
       // "slow the motion" named nothing the user could slow).
-      const bool thrown = at.body[end] > 0 && !at.mocap[end];
+      const bool thrown = free_body(end);
       if (thrown) {
         s << "; nothing prescribes body '" << body_name(end)
           << "', so the tether (or a force on it) threw it: where the load warnings say the "
