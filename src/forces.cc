@@ -503,6 +503,15 @@ double Tether::EndStiffness() const {
   return (Has(kCompression) ? std::max(p_.EA, p_.EAc) : p_.EA) / L0_;
 }
 
+double Tether::EndBendingStiffness(bool end_b) const {
+  if (!Has(kBending)) return 0;
+  const double l = rest_length(end_b ? N_ - 1 : 0);  // [m] the end segment
+  // The next node's moment (none on a single segment), and a clamped end's own.
+  const double k = N_ > 1 ? p_.EI / (l * l * CurvatureWeight(end_b ? N_ - 1 : 1)) : 0;
+  const bool clamped = Has(kClamp) && (end_b ? p_.clamp_b : p_.clamp_a);
+  return k + (clamped ? 2 * p_.EI / (l * l * l) : 0);
+}
+
 double Tether::EndDamping() const { return Has(kDamping) ? p_.damping / L0_ : 0.0; }
 
 Mat3 Tether::LineStiffness(const double* xp) const {

@@ -290,6 +290,14 @@ class Tether {
   // EAc when compressed segments push back). The time-step advisor's coupling frequency at an
   // attached body of effective mass m_eff is sqrt(k_end/m_eff) (docs/coupling.md).
   double EndStiffness() const;
+  // Stiffness the bending presents to a site across a straight line at end A or B [N/m], 0
+  // without the bending effect: moving a pinned end node by d turns the end segment by d/L0,
+  // which gives the next node the moment EI (d/L0)/w (w its curvature weight, L0 on equal
+  // segments; BendingMoments) and the end node the segment's shear EI d/(L0^2 w) (AddBending);
+  // a clamped end's own moment EI (d/L0)/(L0/2) adds 2 EI/L0^3. On a short segment of a stiff
+  // rod it exceeds EA/L0, and the coupling advisor takes the larger (docs/coupling.md, session
+  // 37).
+  double EndBendingStiffness(bool end_b) const;
   // Internal damping the end segment presents to a site [N s/m]: damping/L0, 0 without the
   // damping effect. The coupling advisor's h damping/(L0 m_eff) (docs/coupling.md) and the
   // end-damping bound read it.
