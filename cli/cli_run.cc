@@ -468,7 +468,8 @@ int Info(const std::string& path, const std::vector<std::string>& set) {
       const mjtether::CouplingLimit c = mjtether::GetCouplingLimit(m, k, end);
       if (c.body < 0) continue;
       std::cout << "    coupling at end " << (end == 0 ? "A" : "B") << " (body '"
-                << BodyName(m, c.body) << "'): k_end = EA/L0 = " << c.k_end
+                << BodyName(m, c.body) << "'): k_end = " << mjtether::EndStiffnessName(c)
+                << " = " << c.k_end
                 << " N/m, m_eff = " << c.m_eff << " kg, omega = " << c.omega
                 << " rad/s, omega h = " << c.omega_h;
       if (c.damping_h > 0) std::cout << ", h damping/(L0 m_eff) = " << c.damping_h;

@@ -65,7 +65,10 @@ const Tether* GetTether(const mjModel* m, int k);
 // end is on a body with degrees of freedom (body < 0 otherwise); see docs/coupling.md.
 struct CouplingLimit {
   int body = -1;         // the body
-  double k_end = 0;      // [N/m] end segment stiffness EA/L0 (max(EA, EAc) with EAc)
+  // [N/m] the end's stiffness: the segment's EA/L0 (max(EA, EAc) with EAc), or where larger
+  // the bending's across the line, EI/(L0^2 w) (Tether::EndBendingStiffness; session 37)
+  double k_end = 0;
+  bool bending = false;  // k_end is the bending's
   double m_eff = 0;      // [kg] smallest effective mass at the site, 1/lambda_max(J M^-1 J^T)
   double omega = 0;      // [rad/s] sqrt(k_end/m_eff)
   double omega_h = 0;    // [-] omega times <option timestep>
@@ -83,6 +86,10 @@ struct CouplingLimit {
   bool heavy_node = false;
   double m_node = 0;  // [kg] the end node's mass with its normal added mass
 };
+// What k_end is, for messages: "EA/L0" or the bending's expression.
+inline const char* EndStiffnessName(const CouplingLimit& c) {
+  return c.bending ? "EI/(L0^2 w) (bending across the line, stiffer than EA/L0)" : "EA/L0";
+}
 CouplingLimit GetCouplingLimit(const mjModel* m, int k, int end);
 // How the static start of tether k went at load (start=static; docs/static_start.md): pseudo
 // steps, last displacement, residual force and its node; iterations 0 for start=catenary.

@@ -143,6 +143,48 @@ TEST_F(Coupling, LimitMatchesItsFormula) {
   EXPECT_TRUE(Contains(w, "integrator=implicit")) << w;
 }
 
+// A stiff rod's end is stiffer across the line than along it, and the advisor takes the larger
+// (Tether::EndBendingStiffness, session 37): 100 segments of L0 = 4 cm, EA 3e3 N, EI 400 N m^2
+// on a 3 kg body (site at its centre of mass, m_eff = 3 kg): EI/L0^3 = 6.25e6 N/m against EA/L0
+// = 7.5e4, omega h 2.89 at 2 ms where EA/L0 alone gives 0.32. implicit takes the consistent
+// coupling (from 1), explicit is refused (limit 2) with the bending named as k_end and "a
+// smaller EI"; without EI the same line is the held force's at 0.32. Held-out seed 12434 (EI
+// 467 on 3.6 cm segments of EA 3.2e3 N, a 2.3 kg body) read 0.35, got the held force and ended
+// 0.31 m off its fine step; the consistent coupling takes it to 6 mm.
+TEST_F(Coupling, AStiffRodsBendingIsTheEndsStiffness) {
+  auto xml = [](const std::string& integrator, const std::string& EI) {
+    return "<mujoco><option timestep=\"0.002\"/><custom><text name=\"tether:t\" "
+           "data=\"ends=a,b length=4 segments=100 diameter=0.02 mass_per_length=0.3 EA=3e3 " +
+           EI + " integrator=" + integrator +
+           "\"/></custom><worldbody><body name=\"anchor\" mocap=\"true\"><site name=\"a\"/>"
+           "</body><body name=\"rov\" pos=\"3.9 0 0\"><freejoint/><inertial pos=\"0 0 0\" "
+           "mass=\"3\" diaginertia=\"0.01 0.01 0.01\"/><site name=\"b\"/></body></worldbody>"
+           "</mujoco>";
+  };
+  const double L0 = 0.04, k_bending = 400 / (L0 * L0 * L0);  // [m], [N/m]
+  mjModel* m = Load(xml("implicit", "EI=400"), "rod.xml");
+  ASSERT_NE(m, nullptr);
+  const CouplingLimit c = GetCouplingLimit(m, 0, 1);
+  EXPECT_TRUE(c.bending);
+  EXPECT_NEAR(c.k_end, k_bending, 1e-9 * k_bending);
+  EXPECT_NEAR(c.m_eff, 3, 1e-9);
+  EXPECT_NEAR(c.omega_h, 0.002 * std::sqrt(k_bending / 3), 1e-9);
+  EXPECT_TRUE(c.consistent);
+  mjModel* cable = Load(xml("implicit", ""), "cable.xml");
+  ASSERT_NE(cable, nullptr);
+  const CouplingLimit a = GetCouplingLimit(cable, 0, 1);
+  EXPECT_FALSE(a.bending);
+  EXPECT_NEAR(a.k_end, 3e3 / L0, 1e-9 * 3e3 / L0);
+  EXPECT_FALSE(a.consistent);
+  std::string error;
+  mjModel* refused = LoadModelFromString(xml("explicit", "EI=400"), "rod_explicit.xml", &error);
+  EXPECT_EQ(refused, nullptr);
+  if (refused) models_.push_back(refused);
+  EXPECT_TRUE(Contains(error, "limit 2")) << error;
+  EXPECT_TRUE(Contains(error, "k_end = EI/(L0^2 w) (bending across the line")) << error;
+  EXPECT_TRUE(Contains(error, "or fewer segments or a smaller EI")) << error;
+}
+
 // An implicit tether has no coupling limit (measured stable and within 1% at omega h = 10.6):
 // it loads without a warning and the figure is still reported.
 TEST_F(Coupling, ImplicitTethersAreNotLimited) {

@@ -12,9 +12,10 @@
 //   refused      refused at load (exit 2 from the CLI) with a cause this file recomputes from
 //                the scene (an end or the vehicle below the seabed, ends beyond
 //                length x (1 + max_strain), a diameter or segment count out of its threshold,
-//                more than 1e5 explicit substeps, a coupling omega h = sqrt(EA/(L0 (m + a))) h
-//                at the vehicle at or above the advisor's limit for the integrator: explicit 2,
-//                rk4 0.5 (0.8 until session 29); implicit2 none here, its consistent coupling
+//                more than 1e5 explicit substeps, a coupling omega h = sqrt(k_end/(m + a)) h
+//                (k_end = EA/L0, or EI/L0^3 where larger) at the vehicle at or above the
+//                advisor's limit for the integrator: explicit 2, rk4 0.5 (0.8 until
+//                session 29); implicit2 none here, its consistent coupling
 //                applies from 0.5, docs/coupling.md; with EAc, a segment that starts
 //                compressed beyond its Euler load, StartCompression);
 //   agrees       runs to the end, every value finite, no MuJoCo warning, and agrees with the
@@ -145,6 +146,13 @@ struct Scene {
 
   double holds() const { return EA * 1.0; }  // [N] EA x max_strain (default 1)
   double L0() const { return length / segments; }
+  // [N/m] the stiffness at the vehicle's end that the advisor's coupling frequency reads:
+  // EA/L0, or the bending's EI/L0^3 across the line where larger (equal segments, a pinned
+  // end; Tether::EndBendingStiffness, session 37). EAc is EA in these scenes.
+  double k_end() const {
+    const double axial = EA / L0();
+    return segments > 1 && EI > 0 ? std::max(axial, EI / (L0() * L0() * L0())) : axial;
+  }
 };
 
 double LogUniform(std::mt19937_64& r, double lo, double hi) {
@@ -320,7 +328,7 @@ Scene Make(unsigned long long seed, int draw = kDraw) {
     s.thrust_dir = dir.normalized();
   }
   const double m_eff = s.mass + s.added_min;
-  s.omega_h = std::sqrt(s.EA / (s.L0() * m_eff)) * kStep;
+  s.omega_h = std::sqrt(s.k_end() / m_eff) * kStep;
 
   std::ostringstream x;
   x.precision(10);
@@ -990,7 +998,7 @@ Scene Unstretched(const Scene& s) {
   Scene u = s;
   u.length = s.b.norm();
   ReplaceValue(&u.xml, " length=", s.length, u.length, " ");
-  u.omega_h = std::sqrt(u.EA / (u.L0() * (u.mass + u.added_min))) * kStep;
+  u.omega_h = std::sqrt(u.k_end() / (u.mass + u.added_min)) * kStep;
   if (s.winch && !u.xml.empty()) {
     // The winch's limits widened to hold the twin's length, and its max_speed cut to the
     // twin's shorter segments (a quarter segment per step) as MakeWorld cuts it.
