@@ -748,7 +748,7 @@ void EvaluateLead(const mjModel* m, mjData* d, const AttachedTether& at, double*
   // Nor where end node B outweighs the body (body.node_inertia): the line is then no light
   // spring, and the node, moving with the body, would take a share the tether's step never saw.
   const Vec3 slow =
-      body.node_inertia || K_line.isZero(0) || tether.LineStiffness(x.data()).isZero(0)
+      body.node_inertia || K_line.isZero(0) || !tether.AllTaut(x.data())
           ? Vec3::Zero()
           : SlowModeCorrection(K_line, W, now, dt,
                                SlowModeKappa(tether.params().integrator, status.substeps));

@@ -529,6 +529,15 @@ Mat3 Tether::LineStiffness(const double* xp) const {
   return N_ > 0 ? Mat3(compliance.inverse()) : Mat3::Zero();
 }
 
+bool Tether::AllTaut(const double* xp) const {
+  ConstNodes x(xp, 3, N_ + 1);
+  for (int j = 0; j < N_; ++j) {
+    const double rest = rest_length(j);
+    if (!((x.col(j + 1) - x.col(j)).squaredNorm() > rest * rest)) return false;
+  }
+  return N_ > 0;
+}
+
 double Tether::SnapJump(const double* xp, const double* vp, double dt) const {
   ConstNodes x(xp, 3, N_ + 1), v(vp, 3, N_ + 1);
   double fastest = 0;  // [m/s]

@@ -311,6 +311,10 @@ class Tether {
   // order). Bending, the seabed and the drag are left out, so it is never above the line's own.
   // The consistent coupling's slow-mode correction reads it (docs/coupling.md, session 34).
   Mat3 LineStiffness(const double* x) const;
+  // Every segment longer than its rest length (LineStiffness is not zero exactly then; false
+  // where a length is not finite). The slow-mode correction's check that a step ended as taut
+  // as it began, without LineStiffness's 3 x 3 sums (session 37).
+  bool AllTaut(const double* x) const;
 
   // The segment axial mode (docs/reference.md "Internal damping"): adjacent nodes moving in
   // opposite directions along the line, omega_n = (2/L0) sqrt(EA/mu) [rad/s], and its damping

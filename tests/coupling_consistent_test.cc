@@ -666,7 +666,8 @@ TEST_F(LightVehicle, SwingAcrossATautLineIsNotDampedWhereItsBounceIsFast) {
 // stretched by a strain e between two fixed sites (dry, no gravity): every segment carries
 // T = EA e, so the line's stiffness at end B is EA/L0 along it (the segments' EA/l0 in series)
 // and T/l across it (their geometric stiffnesses T/l_j in series, l = L0 (1 + e) the stretched
-// length), to round-off. Slack by the same strain it is zero (no first-order stiffness).
+// length), to round-off. Slack by the same strain it is zero (no first-order stiffness), and
+// Tether::AllTaut is false.
 TEST_F(LightVehicle, LineStiffnessOfAStraightTautLineIsItsSeriesStiffness) {
   const double EA = 2e6, L0 = 8;  // [N], [m]
   for (double e : {1e-3, -1e-3}) {
@@ -684,6 +685,8 @@ TEST_F(LightVehicle, LineStiffnessOfAStraightTautLineIsItsSeriesStiffness) {
     const double* x = NodePositions(m, d, 0);
     ASSERT_NE(x, nullptr);
     const Mat3 K = GetTether(m, 0)->LineStiffness(x);
+    // AllTaut, the correction's check at the step's end, says the same as K != 0.
+    EXPECT_EQ(GetTether(m, 0)->AllTaut(x), e > 0);
     if (e < 0) {
       EXPECT_TRUE(K.isZero(0)) << K;
       continue;

@@ -150,12 +150,45 @@ void Line(benchmark::State& state, const char* integrator) {
   mj_deleteModel(m);
 }
 
+// The consistent coupling with its slow-mode correction (docs/coupling.md, session 34): a 100 kg
+// body hanging in a current on a taut 10 m line of EA 1e7 N (omega h 4 at 400 segments, above
+// implicit's threshold of 1 at every count here), every segment in tension at every step, so
+// that the correction's line stiffness (Tether::LineStiffness) and its check that the step ended
+// taut (Tether::AllTaut, session 37) run each step.
+void ConsistentTaut(benchmark::State& state) {
+  const int segments = static_cast<int>(state.range(0));
+  std::ostringstream s;
+  s << R"(<mujoco><option timestep="0.002"/><custom>
+    <text name="water" data="density=1025 current=0.5,0,0"/>
+    <text name="tether:t" data="ends=a,b length=10 segments=)"
+    << segments << R"( diameter=0.02 mass_per_length=0.3 EA=1e7
+          Cdn=1.2 Cdt=0.01 Can=1 integrator=implicit"/></custom>
+    <worldbody><body name="anchor" mocap="true"><site name="a"/></body>
+      <body name="rov" pos="0 0 -10.001"><freejoint/><inertial pos="0 0 0" mass="100"
+          diaginertia="1 1 1"/><site name="b"/></body></worldbody></mujoco>)";
+  std::string error;
+  mjModel* m = mjtether::LoadModelFromString(s.str(), "b.xml", &error);
+  if (!m) {
+    state.SkipWithError(error.c_str());
+    return;
+  }
+  if (!mjtether::GetCouplingLimit(m, 0, 1).consistent) {
+    state.SkipWithError("not the consistent coupling, which this benchmark assumes");
+  } else {
+    TimeWarmedSteps(state, m, segments);
+  }
+  mjtether::Detach(m);
+  mj_deleteModel(m);
+}
+
 void BM_LineBdf2(benchmark::State& s) { Line(s, "bdf2"); }
 void BM_LineImplicit(benchmark::State& s) { Line(s, "implicit"); }
 void BM_LineImplicit2(benchmark::State& s) { Line(s, "implicit2"); }
 BENCHMARK(BM_LineBdf2)->Arg(80)->Arg(100);
 BENCHMARK(BM_LineImplicit)->Arg(80)->Arg(100);
 BENCHMARK(BM_LineImplicit2)->Arg(100);
+void BM_ConsistentTaut(benchmark::State& s) { ConsistentTaut(s); }
+BENCHMARK(BM_ConsistentTaut)->Arg(100)->Arg(400);
 
 void BM_RingWatchOn(benchmark::State& s) { Watch(s, true); }
 void BM_RingWatchOff(benchmark::State& s) { Watch(s, false); }
