@@ -1997,7 +1997,8 @@ std::string RefusedBandRate(Integrator integrator, double omega_h) {
 }
 
 // The coupling part of the time-step advisor (docs/coupling.md): for each end on a free body,
-// the coupling frequency omega = sqrt(k_end / m_eff), k_end = EA/L0, m_eff = 1/lambda_max(W)
+// the coupling frequency omega = sqrt(k_end / m_eff), k_end = EA/L0 (or the bending's EI/(L0^2
+// w) across the line where larger, session 37), m_eff = 1/lambda_max(W)
 // the smallest effective mass of the body at the site (W = J M^-1 J^T at the model's initial
 // configuration). An explicit coupling (coupling=explicit, or MuJoCo's RK4, with which the
 // implicit end is not available) is refused at omega h >= its limit and warned about above
