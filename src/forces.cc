@@ -506,10 +506,13 @@ double Tether::EndStiffness() const {
 double Tether::EndBendingStiffness(bool end_b) const {
   if (!Has(kBending)) return 0;
   const double l = rest_length(end_b ? N_ - 1 : 0);  // [m] the end segment
-  // The next node's moment (none on a single segment), and a clamped end's own.
-  const double k = N_ > 1 ? p_.EI / (l * l * CurvatureWeight(end_b ? N_ - 1 : 1)) : 0;
-  const bool clamped = Has(kClamp) && (end_b ? p_.clamp_b : p_.clamp_a);
-  return k + (clamped ? 2 * p_.EI / (l * l * l) : 0);
+  auto clamped = [&](bool b) { return Has(kClamp) && (b ? p_.clamp_b : p_.clamp_a); };
+  // The next node's moment; on a single segment the next node is the other end, with a
+  // moment only where that end is clamped (weight L0/2). And a clamped end's own.
+  const double k = N_ > 1            ? p_.EI / (l * l * CurvatureWeight(end_b ? N_ - 1 : 1))
+                   : clamped(!end_b) ? 2 * p_.EI / (l * l * l)
+                                     : 0;
+  return k + (clamped(end_b) ? 2 * p_.EI / (l * l * l) : 0);
 }
 
 double Tether::EndDamping() const { return Has(kDamping) ? p_.damping / L0_ : 0.0; }

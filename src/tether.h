@@ -294,7 +294,8 @@ class Tether {
   // without the bending effect: moving a pinned end node by d turns the end segment by d/L0,
   // which gives the next node the moment EI (d/L0)/w (w its curvature weight, L0 on equal
   // segments; BendingMoments) and the end node the segment's shear EI d/(L0^2 w) (AddBending);
-  // a clamped end's own moment EI (d/L0)/(L0/2) adds 2 EI/L0^3. On a short segment of a stiff
+  // a clamped end's own moment EI (d/L0)/(L0/2) adds 2 EI/L0^3 (on a single segment the next
+  // node is the other end: 2 EI/L0^3 where it is clamped, else 0). On a short segment of a stiff
   // rod it exceeds EA/L0, and the coupling advisor takes the larger (docs/coupling.md, session
   // 37).
   double EndBendingStiffness(bool end_b) const;

@@ -719,38 +719,42 @@ TEST(Energy, ExplicitSlackSwitchingGainsNoEnergyBeyondTheEndsWork) {
 // forces: a straight line of 6 segments of L0 = 0.5 m along x (dry, no gravity, EA and EI) with
 // end node B (then A) moved across it by d = 1e-6 L0. The force on the moved node across the
 // line is -k d, k = EI/L0^3 at a pinned end and 3 EI/L0^3 at a clamped one (the end segment's
-// shear from the next node's moment, and a clamp's own moment); the axial force's share across
-// is O(d^2) and EA/L0 = 2e4 N/m is 6.4e-3 of k, so both are below the 1e-5 tolerance. Without
-// the bending effect k is 0 (the axial end stiffness EA/L0 is EndStiffness).
+// shear from the next node's moment, and a clamp's own moment). On a single segment there is no
+// interior node: k = 0 pinned, and 4 EI/L0^3 clamped at both ends (each end's moment). The axial
+// force's share across is EA d^2/(2 L0^3) per metre, 1e-8 N/m here, far below the tolerance of
+// 1e-5 EI/L0^3. Without the bending effect k is 0 (the axial EA/L0 is EndStiffness).
 TEST(Forces, EndBendingStiffnessIsTheEndNodesForceAcrossAStraightLine) {
   const Environment env = NoGravity();
-  const int N = 6;
   const double L0 = 0.5, EI = 25, d = 1e-6 * L0;  // [m], [N m^2], [m]
-  for (bool clamped : {false, true}) {
-    for (bool end_b : {true, false}) {
-      TetherParams p;
-      p.length = N * L0;
-      p.segments = N;
-      p.diameter = 0.02;
-      p.mass_per_length = 1;
-      p.EA = 1e4;  // [N]
-      p.EI = EI;
-      p.clamp_a = p.clamp_b = clamped;
-      p.integrator = Integrator::kImplicit;
-      Tether t = Make(p, env);
-      const double k = (clamped ? 3 : 1) * EI / (L0 * L0 * L0);  // [N/m]
-      EXPECT_NEAR(t.EndBendingStiffness(end_b), k, 1e-12 * k) << clamped << end_b;
-      Ends ends;
-      ends.b.pos = Vec3(N * L0, 0, 0);
-      std::vector<double> x(3 * (N + 1), 0.0), v(x.size(), 0.0), f(x.size());
-      for (int i = 0; i <= N; ++i) x[3 * i] = i * L0;
-      const int node = end_b ? N : 0;
-      x[3 * node + 1] = d;
-      (end_b ? ends.b : ends.a).pos.y() = d;
-      std::vector<double> work(t.WorkspaceSize());
-      t.ComputeForces(x.data(), v.data(), ends, f.data(), nullptr, work.data());
-      EXPECT_NEAR(-f[3 * node + 1] / d, k, 1e-5 * k) << "clamped " << clamped << " end B "
-                                                      << end_b;
+  for (int N : {6, 1}) {
+    for (bool clamped : {false, true}) {
+      for (bool end_b : {true, false}) {
+        TetherParams p;
+        p.length = N * L0;
+        p.segments = N;
+        p.diameter = 0.02;
+        p.mass_per_length = 1;
+        p.EA = 1e4;  // [N]
+        p.EI = EI;
+        p.clamp_a = p.clamp_b = clamped;
+        p.integrator = Integrator::kImplicit;
+        Tether t = Make(p, env);
+        // One segment: no interior node; clamped at both ends, each end's moment (4 EI/L0^3).
+        const double k = (N > 1 ? (clamped ? 3 : 1) : (clamped ? 4 : 0)) * EI / (L0 * L0 * L0);
+        const double tolerance = 1e-5 * EI / (L0 * L0 * L0);  // [N/m]
+        EXPECT_NEAR(t.EndBendingStiffness(end_b), k, 1e-12 * k) << N << clamped << end_b;
+        Ends ends;
+        ends.b.pos = Vec3(N * L0, 0, 0);
+        std::vector<double> x(3 * (N + 1), 0.0), v(x.size(), 0.0), f(x.size());
+        for (int i = 0; i <= N; ++i) x[3 * i] = i * L0;
+        const int node = end_b ? N : 0;
+        x[3 * node + 1] = d;
+        (end_b ? ends.b : ends.a).pos.y() = d;
+        std::vector<double> work(t.WorkspaceSize());
+        t.ComputeForces(x.data(), v.data(), ends, f.data(), nullptr, work.data());
+        EXPECT_NEAR(-f[3 * node + 1] / d, k, tolerance)
+            << N << " segments, clamped " << clamped << ", end B " << end_b;
+      }
     }
   }
   TetherParams p = SpringParams();
