@@ -719,8 +719,10 @@ void EvaluateLead(const mjModel* m, mjData* d, const AttachedTether& at, double*
   from.time = c[kLeadTime];
   to.time = c[kLeadTime] + dt;
   WatchSnaps(at, x.data(), v.data(), dt, d->time, u);
-  // The line's stiffness at the step's start for the slow-mode correction (none on a winch).
-  const Mat3 K_line = at.winch ? Mat3::Zero() : tether.LineStiffness(x.data());
+  // The line's stiffness at the step's start for the slow-mode correction (none on a winch, nor
+  // where end node B outweighs the body, which takes no correction below).
+  const Mat3 K_line =
+      at.winch || body.node_inertia ? Mat3::Zero() : tether.LineStiffness(x.data());
   StepStatus status;
   if (at.winch) {
     // The drum's speed over this step from ctrl, the tension at the drum (end A's last
@@ -2075,9 +2077,9 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
       // held-out seed 12434 (EI 467 N m^2 on 3.6 cm segments of EA 3.2e3 N, a 2.3 kg body)
       // read omega h 0.35 from EA/L0, took the held end force, and ended 0.31 m off its fine
       // step; its bending gives omega h 3.6, and the consistent coupling 6 mm (session 37).
-      const double k_bending = t.EndBendingStiffness(end == 1);  // [N/m]
-      c.k_end = std::max(t.EndStiffness(), k_bending);
-      c.bending = k_bending > t.EndStiffness();
+      const double k_axial = t.EndStiffness(), k_bending = t.EndBendingStiffness(end == 1);
+      c.k_end = std::max(k_axial, k_bending);  // [N/m]
+      c.bending = k_bending > k_axial;
       c.m_eff = 1 / lambda;
       c.omega = std::sqrt(c.k_end * lambda);
       c.omega_h = c.omega * h;

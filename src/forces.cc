@@ -506,13 +506,13 @@ double Tether::EndStiffness() const {
 double Tether::EndBendingStiffness(bool end_b) const {
   if (!Has(kBending)) return 0;
   const double l = rest_length(end_b ? N_ - 1 : 0);  // [m] the end segment
+  const double k_clamp = 2 * p_.EI / (l * l * l);     // [N/m] a clamp's moment, weight l/2
   auto clamped = [&](bool b) { return Has(kClamp) && (b ? p_.clamp_b : p_.clamp_a); };
   // The next node's moment; on a single segment the next node is the other end, with a
-  // moment only where that end is clamped (weight L0/2). And a clamped end's own.
-  const double k = N_ > 1            ? p_.EI / (l * l * CurvatureWeight(end_b ? N_ - 1 : 1))
-                   : clamped(!end_b) ? 2 * p_.EI / (l * l * l)
-                                     : 0;
-  return k + (clamped(end_b) ? 2 * p_.EI / (l * l * l) : 0);
+  // moment only where that end is clamped. And a clamped end's own.
+  const double next = N_ > 1 ? p_.EI / (l * l * CurvatureWeight(end_b ? N_ - 1 : 1))
+                             : (clamped(!end_b) ? k_clamp : 0);
+  return next + (clamped(end_b) ? k_clamp : 0);
 }
 
 double Tether::EndDamping() const { return Has(kDamping) ? p_.damping / L0_ : 0.0; }
