@@ -515,6 +515,14 @@ double Tether::EndBendingStiffness(bool end_b) const {
   return next + (clamped(end_b) ? k_clamp : 0);
 }
 
+double Tether::EndSeabedStiffness(bool end_b) const {
+  return Has(kSeabed) ? seabed_k_ * Share(end_b ? N_ : 0) : 0.0;
+}
+
+double Tether::EndSeabedDamping(bool end_b) const {
+  return Has(kSeabed) ? seabed_c_ * Share(end_b ? N_ : 0) : 0.0;
+}
+
 double Tether::EndDamping() const { return Has(kDamping) ? p_.damping / L0_ : 0.0; }
 
 Mat3 Tether::LineStiffness(const double* xp) const {

@@ -299,6 +299,17 @@ class Tether {
   // rod it exceeds EA/L0, and the coupling advisor takes the larger (docs/coupling.md, session
   // 37).
   double EndBendingStiffness(bool end_b) const;
+  // Stiffness a flat or geom seabed presents to a site through its end node in contact [N/m],
+  // 0 without the seabed effect: the penalty seabed_stiffness [N/m^2] over the node's share of
+  // the tether's length (half the end segment), normal to the seabed. A body whose end node
+  // touches the seabed feels it through the end force, as it feels the end segment; the
+  // coupling advisor takes the consistent coupling where it is stiff on the body's step, and
+  // stops a held end whose node lands there (docs/coupling.md, session 38: seed 9022, one
+  // segment of 56 m on a 7.7 kg vehicle driven into the seabed).
+  double EndSeabedStiffness(bool end_b) const;
+  // Damping the seabed presents to a site through its end node in contact [N s/m]: its damping
+  // per length (critical for the tether's mass unless declared) over the node's share.
+  double EndSeabedDamping(bool end_b) const;
   // Internal damping the end segment presents to a site [N s/m]: damping/L0, 0 without the
   // damping effect. The coupling advisor's h damping/(L0 m_eff) (docs/coupling.md) and the
   // end-damping bound read it.

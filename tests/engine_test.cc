@@ -761,5 +761,52 @@ TEST(Forces, EndBendingStiffnessIsTheEndNodesForceAcrossAStraightLine) {
   EXPECT_EQ(Make(p, env).EndBendingStiffness(true), 0);
 }
 
+// The seabed's stiffness and damping at an end node (the coupling advisor's k_end where it is
+// the largest, session 38): a straight line lying on a flat seabed, end node B (or A) pressed
+// into it by d at a sinking speed v, is pushed back by k L0/2 d + c L0/2 v, the penalty and its
+// damping over the node's share; the segment's own tension, EA d^2/(2 L0^2) at the angle d/L0,
+// adds EA d^3/(2 L0^3) = 1.6e-7 N of the 32 N, below the tolerance.
+TEST(Forces, EndSeabedStiffnessIsTheEndNodesPushFromTheSeabed) {
+  Environment env = NoGravity();
+  env.wet = true;
+  env.water.has_seabed = true;
+  env.water.seabed = 0;               // [m]
+  env.water.seabed_stiffness = 2e5;   // [N/m^2]
+  env.water.seabed_damping = 300;     // [N s/m^2]
+  const double L0 = 2, d = 1e-4, v = 0.01;  // [m], [m], [m/s]
+  const int N = 4;
+  TetherParams p;
+  p.length = N * L0;
+  p.segments = N;
+  p.diameter = 0.02;
+  p.mass_per_length = 1;
+  p.EA = 1e4;  // [N]
+  p.Cdn = p.Cdt = p.Can = 0;
+  p.integrator = Integrator::kImplicit;
+  Tether t = Make(p, env);
+  ASSERT_TRUE(t.params().effects & kSeabed);
+  const double k = 2e5 * L0 / 2, c = 300 * L0 / 2;  // [N/m], [N s/m]
+  for (bool end_b : {true, false}) {
+    EXPECT_NEAR(t.EndSeabedStiffness(end_b), k, 1e-12 * k);
+    EXPECT_NEAR(t.EndSeabedDamping(end_b), c, 1e-12 * c);
+    Ends ends;
+    ends.b.pos = Vec3(N * L0, 0, 0);
+    std::vector<double> x(3 * (N + 1), 0.0), vel(x.size(), 0.0), f(x.size());
+    for (int i = 0; i <= N; ++i) x[3 * i] = i * L0;
+    const int node = end_b ? N : 0;
+    x[3 * node + 2] = -d;
+    vel[3 * node + 2] = -v;
+    EndState& e = end_b ? ends.b : ends.a;
+    e.pos.z() = -d;
+    e.vel.z() = -v;
+    std::vector<double> work(t.WorkspaceSize());
+    t.ComputeForces(x.data(), vel.data(), ends, f.data(), nullptr, work.data());
+    EXPECT_NEAR(f[3 * node + 2], k * d + c * v, 1e-6 * (k * d + c * v)) << "end B " << end_b;
+  }
+  env.water.has_seabed = false;
+  EXPECT_EQ(Make(p, env).EndSeabedStiffness(true), 0);
+  EXPECT_EQ(Make(p, env).EndSeabedDamping(true), 0);
+}
+
 }  // namespace
 }  // namespace mjtether
