@@ -473,6 +473,10 @@ int Info(const std::string& path, const std::vector<std::string>& set) {
                 << " N/m, m_eff = " << c.m_eff << " kg, omega = " << c.omega
                 << " rad/s, omega h = " << c.omega_h;
       if (c.damping_h > 0) std::cout << ", h damping/(L0 m_eff) = " << c.damping_h;
+      if (c.seabed_omega_h > 0) {
+        std::cout << ", the seabed under the end node: omega h = " << c.seabed_omega_h
+                  << ", h c/m_eff = " << c.seabed_damping_h;
+      }
       if (c.consistent) {
         std::cout << "; consistent coupling (end node B solved with the body in the tether's "
                      "step)";

@@ -80,6 +80,11 @@ struct CouplingLimit {
   // [-] h damping/(L0 m_eff): the end segment's internal damping on the body over the step
   // (0 without damping); the consistent coupling is also taken from 0.025 on (docs/coupling.md)
   double damping_h = 0;
+  // [-] the seabed under end node B where it touches (0 without the seabed): omega_s h with
+  // omega_s = sqrt(k_s/m_eff), k_s = seabed_stiffness x the node's share, and h c_s/m_eff for
+  // its damping; the consistent coupling is also taken from 0.7 of the larger (session 38)
+  double seabed_omega_h = 0;
+  double seabed_damping_h = 0;
   // End node B (mass and normal added mass) is heavier than m_eff: the held force would lose
   // an inertia larger than the body's, so implicit and bdf2 take the consistent coupling
   // whatever omega h (docs/coupling.md, session 23)

@@ -233,6 +233,112 @@ double AdvisedStep(const std::string& message) {
   return at == std::string::npos ? 0 : std::atof(message.c_str() + at + key.size());
 }
 
+// The seabed under end node B, where the node touches it, is a spring and damper on the body
+// (Tether::EndSeabedStiffness, EndSeabedDamping; session 38), and the consistent coupling is
+// taken where either is stiff on the body's step: max(omega_s h, h c_s/m_eff) >= 0.7
+// (kLeadFromSeabed). One segment of L0 = 36 m on an 8 kg body (no added mass: m_eff = 8 kg):
+// seabed_stiffness 1e5 N/m^2 over L0/2 is k_s = 1.8e6 N/m, omega_s h 0.95 at 2 ms; its damping,
+// critical for the tether's 0.2 kg/m, 2 sqrt(1e5 x 0.2) L0/2 = 5.1e3 N s/m, gives h c_s/m_eff
+// 1.27. A seabed of 2.5e4 N/m^2 (omega_s h 0.47) takes it from a damping of 155.6 N s/m^2
+// (h c_s/m_eff 1.4) and not from 55.6 (0.5). rk4 (no consistent coupling) is not refused for a
+// seabed the body may never reach. The body, thrust down and out at 2 kN, lands on the seabed
+// through its end node at about 25 m/s: the contact's damping ratio 5.1e3/(2 sqrt(1.8e6 x 8)) =
+// 0.67 gives a restitution of exp(-0.67 pi/sqrt(1 - 0.67^2)) = 0.06, a rebound of 1.5 m/s
+// against the 210 m/s^2 that press it down: 5 mm. With the held force (before session 38) it
+// bounced 0.21 m off the seabed and its end tension averaged 9.5% off its 0.2 ms self over
+// 0.2-0.6 s; the scene fuzzer's seed 9022 (bdf2, one 56 m segment, a 7.7 kg vehicle) read 38%.
+TEST_F(Coupling, TheSeabedUnderTheEndNodeTakesTheConsistentCoupling) {
+  auto xml = [](const std::string& integrator, double step, const std::string& seabed) {
+    std::ostringstream s;
+    s << "<mujoco><option timestep=\"" << step << "\"/><custom><text name=\"water\" "
+      << "data=\"density=1025" << seabed << "\"/><text name=\"tether:t\" data=\"ends=a,b "
+      << "length=36 segments=1 diameter=0.01 mass_per_length=0.2 EA=4000 integrator="
+      << integrator << "\"/><text name=\"thrust:thr\" data=\"t=0,0.05 ctrl=0,2000\"/>"
+      << "</custom><worldbody><body name=\"tms\" mocap=\"true\"><site name=\"a\"/></body>"
+      << "<body name=\"rov\" pos=\"30 0 -3\"><freejoint/><inertial pos=\"0 0 0\" mass=\"8\" "
+      << "diaginertia=\"0.05 0.05 0.05\"/><site name=\"b\"/></body></worldbody><actuator>"
+      << "<motor name=\"thr\" site=\"b\" gear=\"0.6 0 -0.8 0 0 0\"/></actuator></mujoco>";
+    return s.str();
+  };
+  const double k_s = 1e5 * 18, c_s = 2 * std::sqrt(1e5 * 0.2) * 18;  // [N/m], [N s/m]
+  mjModel* m = Load(xml("bdf2", 0.002, " seabed=-5"), "seabed.xml");
+  ASSERT_NE(m, nullptr);
+  const CouplingLimit c = GetCouplingLimit(m, 0, 1);
+  EXPECT_NEAR(c.k_end, 4000 / 36.0, 1e-9);  // the line's own, not the seabed's
+  EXPECT_NEAR(c.seabed_omega_h, 0.002 * std::sqrt(k_s / 8), 1e-9);
+  EXPECT_NEAR(c.seabed_damping_h, 0.002 * c_s / 8, 1e-9);
+  EXPECT_TRUE(c.consistent);
+  mjModel* open = Load(xml("bdf2", 0.002, ""), "open.xml");
+  ASSERT_NE(open, nullptr);
+  const CouplingLimit a = GetCouplingLimit(open, 0, 1);
+  EXPECT_EQ(a.seabed_omega_h, 0);
+  EXPECT_EQ(a.seabed_damping_h, 0);
+  EXPECT_FALSE(a.consistent);
+  for (const auto& [damping, consistent] : {std::pair{155.6, true}, std::pair{55.6, false}}) {
+    std::ostringstream seabed;
+    seabed << " seabed=-5 seabed_stiffness=2.5e4 seabed_damping=" << damping;
+    mjModel* soft = Load(xml("bdf2", 0.002, seabed.str()), "soft.xml");
+    ASSERT_NE(soft, nullptr);
+    const CouplingLimit s = GetCouplingLimit(soft, 0, 1);
+    EXPECT_NEAR(s.seabed_omega_h, 0.002 * std::sqrt(2.5e4 * 18 / 8), 1e-9);
+    EXPECT_NEAR(s.seabed_damping_h, 0.002 * damping * 18 / 8, 1e-9);
+    EXPECT_EQ(s.consistent, consistent) << damping;
+  }
+  // rk4 keeps the held force: warned at load, stopped where the node lands (CheckSeabedEnd),
+  // with the advice; the step it advises runs through the landing.
+  mjModel* rk4 = Load(xml("rk4", 0.002, " seabed=-5"), "seabed_rk4.xml");
+  ASSERT_NE(rk4, nullptr);
+  EXPECT_FALSE(GetCouplingLimit(rk4, 0, 1).consistent);
+  // (Among the thrust's and the undeclared vehicle's.)
+  int seabed_warnings = 0;
+  for (const std::string& w : Warnings(rk4)) {
+    seabed_warnings += Contains(w, "the run stops if the node touches the seabed");
+  }
+  EXPECT_EQ(seabed_warnings, 1);
+  for (mjModel* quiet : {m, open}) {
+    for (const std::string& w : Warnings(quiet)) {
+      EXPECT_FALSE(Contains(w, "touches the seabed")) << w;
+    }
+  }
+  std::string stop;
+  RunScene(rk4, 0.6, &stop, 0.002);
+  EXPECT_TRUE(Contains(stop, "seabed_rk4.xml: tether 't' stopped at t = 0.1")) << stop;
+  EXPECT_TRUE(Contains(stop, "its end node B touched the seabed, and body 'rov'")) << stop;
+  EXPECT_TRUE(Contains(stop, "omega h = 0.948683 and h c/m_eff = 1.27279")) << stop;
+  EXPECT_TRUE(Contains(stop, "Use integrator=bdf2 (the default) or implicit")) << stop;
+  const double advised = AdvisedStep(stop);
+  EXPECT_GT(advised, 0);
+  mjModel* cured = Load(xml("rk4", advised, " seabed=-5"), "seabed_rk4_cured.xml");
+  ASSERT_NE(cured, nullptr);
+  std::string cured_stop;
+  RunScene(cured, 0.6, &cured_stop, 0.002);
+  EXPECT_EQ(cured_stop, "");
+  // The landing: from the first contact on, the body never rises 2 cm (4x the rebound above)
+  // over the seabed, and its end tension over 0.2-0.6 s (the landing and the slide until the
+  // tether takes the load) averages within 5% of the 0.2 ms run's.
+  std::string stopped;
+  const std::vector<Sample> run = RunScene(m, 0.6, &stopped, 0.002);
+  ASSERT_EQ(stopped, "");
+  mjModel* fine = Load(xml("bdf2", 0.0002, " seabed=-5"), "seabed_fine.xml");
+  ASSERT_NE(fine, nullptr);
+  const std::vector<Sample> ref = RunScene(fine, 0.6, &stopped, 0.002);
+  ASSERT_EQ(stopped, "");
+  ASSERT_EQ(run.size(), ref.size());
+  bool landed = false;
+  double rise = -INFINITY, mean = 0, mean_ref = 0;  // [m], [N], [N]
+  int n = 0;
+  for (size_t i = 0; i < run.size(); ++i) {
+    landed = landed || run[i].pos.z() < -5;
+    if (landed) rise = std::max(rise, run[i].pos.z() + 5);
+    if (run[i].t < 0.2 - 1e-9) continue;
+    mean += run[i].tension, mean_ref += ref[i].tension, ++n;
+  }
+  ASSERT_TRUE(landed);
+  EXPECT_LT(rise, 0.02);
+  mean /= n, mean_ref /= n;
+  EXPECT_NEAR(mean, mean_ref, 0.05 * mean_ref);
+}
+
 // The chatter warning above half the limit, and the refusal at it, advise a step that leaves
 // every coupling warning behind: kCouplingAccurate / omega. Until session 28 they advised
 // limit / omega, the largest step that loads, which for the warning was above the step that

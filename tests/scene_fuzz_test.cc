@@ -42,7 +42,9 @@
 //                EA x max_strain, ends pulled beyond length x (1 + max_strain), an end moving
 //                more than half of max_strain L0 per step, an end below the seabed, a stretched
 //                start; an end damping too stiff for the vehicle's step (h lambda > 2, from
-//                an upper bound of the end's drag and damping); a coupling chatter (the
+//                an upper bound of the end's drag and damping); the end node landing on a
+//                seabed stiff on the vehicle's step under the held end force (the scene's
+//                seabed_rate() >= 0.7 and the vehicle at the seabed); a coupling chatter (the
 //                run-time work balance) where omega h is at
 //                least half the advisor's limit; or, where the message blames the step, the
 //                same scene at a 10x smaller step runs to the end, or, where that fails and
@@ -149,6 +151,16 @@ struct Scene {
   // [N/m] the stiffness at the vehicle's end that the advisor's coupling frequency reads:
   // EA/L0, or the bending's EI/L0^3 across the line where larger (equal segments, a pinned
   // end; Tether::EndBendingStiffness, session 37). EAc is EA in these scenes.
+  // [-] the seabed under the end node on the vehicle's step where it touches (CheckSeabedEnd,
+  // plugin/plugin.cc; session 38): max(omega_s h, h c_s/m_eff) with the default penalty 1e5
+  // N/m^2 and its damping, critical for the tether's mass, over the node's share L0/2; 0
+  // without a seabed. m_eff = m + the smallest added mass, as for omega_h.
+  double seabed_rate() const {
+    if (seabed_kind == 0) return 0;
+    const double share = L0() / 2, m_eff = mass + added_min;  // [m], [kg]
+    const double k = 1e5 * share, c = 2 * std::sqrt(1e5 * mpl) * share;  // [N/m], [N s/m]
+    return std::max(std::sqrt(k / m_eff), c / m_eff) * kStep;
+  }
   double k_end() const {
     const double axial = EA / L0();
     return segments > 1 && EI > 0 ? std::max(axial, EI / (L0() * L0() * L0())) : axial;
@@ -1462,6 +1474,15 @@ Outcome JudgeRuns(const Scene& s) {
     if (Contains(msg, "too fast for the step")) {
       return {"diverged: end motion too fast for the step",
               coarse.vehicle_speed > fast || tms_speed > fast, msg};
+    }
+    if (Contains(msg, "touched the seabed, and body")) {
+      // CheckSeabedEnd (plugin/plugin.cc): the held end force with the seabed under the end
+      // node stiff on the vehicle's step (from 0.7), stopped where the node (at the vehicle's
+      // origin) touched it.
+      return {"diverged: end node on a stiff seabed",
+              s.seabed_kind != 0 && s.seabed_rate() >= 0.99 * 0.7 &&
+                  coarse.vehicle.z() < s.seabed + 0.05,
+              msg};
     }
     if (Contains(msg, "seabed penetration")) {
       return {"diverged: seabed penetration",
