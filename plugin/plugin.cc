@@ -1155,6 +1155,21 @@ double SeabedRate(const CouplingLimit& c, double h) {
   return std::max(c.seabed_omega_h, c.seabed_damping_h) * h / (c.omega_h / c.omega);
 }
 
+// What cures a watched seabed end at the step h [s], for the load warning and the stop: the
+// integrators that would take the consistent coupling there, a step that halves the rate, more
+// segments (the end node's share is half the end segment).
+double StepAtMost(double x);  // (below)
+std::string SeabedCure(const AttachedTether& at, int end, double h) {
+  std::ostringstream s;
+  if (at.seabed_cure[end]) {
+    s << "integrator=bdf2 (the default) or implicit (the end node is solved with the body), or ";
+  }
+  const double rate = SeabedRate(at.limit[end], h);  // [-]
+  s << "<option timestep> <= " << StepAtMost(0.5 * kLeadFromSeabed * h / rate)
+    << " s, or more segments (the end node's share is half the end segment)";
+  return s.str();
+}
+
 // After Evaluate (the held end force): stops the tether (status kSeabedEnd) when the node of an
 // end on a body touches the seabed where the seabed is stiff on the body's step, max(omega_s h,
 // h c_s/m_eff) >= kLeadFromSeabed (AdviseCoupling). The body gets the node's seabed contact at
@@ -2188,10 +2203,7 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
           << "': the seabed under its end node is stiff on the body's step (omega h = "
           << c.seabed_omega_h << ", h c/m_eff = " << c.seabed_damping_h << ", at or above "
           << kLeadFromSeabed << ") and the body gets the held end force: the run stops if the "
-          << "node touches the seabed; "
-          << (at.seabed_cure[end] ? "integrator=bdf2 (the default) or implicit, or " : "")
-          << "more segments or <option timestep> <= "
-          << StepAtMost(0.5 * kLeadFromSeabed * h / seabed_h) << " s avoid that";
+          << "node touches the seabed; to avoid that use " << SeabedCure(at, end, h);
         set->warnings.push_back(w.str());
       }
       if (c.heavy_node && !c.consistent) {
@@ -2881,7 +2893,6 @@ std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d) {
       const CouplingLimit& c = at.limit[end];
       const char* body = mj_id2name(m, mjOBJ_BODY, at.body[end]);
       const double h = m->opt.timestep, scale = h / (c.omega_h / c.omega);  // [-]
-      const double rate = SeabedRate(c, h);
       s << set->source << ": tether '" << at.name << "' stopped at t = " << u[kBadTime]
         << " s: its end node " << (end == 0 ? "A" : "B") << " touched the seabed, and body '"
         << (body ? body : "?") << "' gets the node's seabed contact as the held end force: "
@@ -2891,14 +2902,9 @@ std::optional<std::string> CheckDivergence(const mjModel* m, const mjData* d) {
         << c.seabed_omega_h * scale << " and h c/m_eff = " << c.seabed_damping_h * scale
         << " at <option timestep> " << h << " s, at or above " << kLeadFromSeabed
         << ", where the body bounces off the seabed and its end force depends on the step "
-           "(docs/coupling.md, session 38). Use ";
-      if (at.seabed_cure[end]) {
-        s << "integrator=bdf2 (the default) or implicit (the end node is solved with the "
-             "body), or ";
-      }
-      s << "<option timestep> <= " << StepAtMost(0.5 * kLeadFromSeabed * h / rate)
-        << " s, or more segments (the end node's share is half the end segment), or a smaller "
-           "'seabed_stiffness' or 'seabed_damping' in <text name=\"water\">.";
+           "(docs/coupling.md, session 38). Use "
+        << SeabedCure(at, end, h)
+        << ", or a smaller 'seabed_stiffness' or 'seabed_damping' in <text name=\"water\">.";
       return s.str();
     }
     if (u[kStatus] == kEndDamping) {

@@ -714,6 +714,19 @@ TEST(Energy, ExplicitSlackSwitchingGainsNoEnergyBeyondTheEndsWork) {
   EXPECT_LT(excess, 0.05 * (gross + swing) + 1e-3) << "W " << W << " J, gross " << gross;
 }
 
+// The line of the end-stiffness tests below: N segments of L0 [m], EA 1e4 N, 2 cm, 1 kg/m,
+// implicit.
+TetherParams EndTestLine(int N, double L0) {
+  TetherParams p;
+  p.length = N * L0;
+  p.segments = N;
+  p.diameter = 0.02;
+  p.mass_per_length = 1;
+  p.EA = 1e4;  // [N]
+  p.integrator = Integrator::kImplicit;
+  return p;
+}
+
 // ---------------------------------------------------------------------------------------------
 // Tether::EndBendingStiffness, the coupling advisor's stiffness across the line, against the
 // forces: a straight line of 6 segments of L0 = 0.5 m along x (dry, no gravity, EA and EI) with
@@ -729,15 +742,9 @@ TEST(Forces, EndBendingStiffnessIsTheEndNodesForceAcrossAStraightLine) {
   for (int N : {6, 1}) {
     for (bool clamped : {false, true}) {
       for (bool end_b : {true, false}) {
-        TetherParams p;
-        p.length = N * L0;
-        p.segments = N;
-        p.diameter = 0.02;
-        p.mass_per_length = 1;
-        p.EA = 1e4;  // [N]
+        TetherParams p = EndTestLine(N, L0);
         p.EI = EI;
         p.clamp_a = p.clamp_b = clamped;
-        p.integrator = Integrator::kImplicit;
         Tether t = Make(p, env);
         // One segment: no interior node; clamped at both ends, each end's moment (4 EI/L0^3).
         const double k = (N > 1 ? (clamped ? 3 : 1) : (clamped ? 4 : 0)) * EI / (L0 * L0 * L0);
@@ -775,14 +782,8 @@ TEST(Forces, EndSeabedStiffnessIsTheEndNodesPushFromTheSeabed) {
   env.water.seabed_damping = 300;     // [N s/m^2]
   const double L0 = 2, d = 1e-4, v = 0.01;  // [m], [m], [m/s]
   const int N = 4;
-  TetherParams p;
-  p.length = N * L0;
-  p.segments = N;
-  p.diameter = 0.02;
-  p.mass_per_length = 1;
-  p.EA = 1e4;  // [N]
+  TetherParams p = EndTestLine(N, L0);
   p.Cdn = p.Cdt = p.Can = 0;
-  p.integrator = Integrator::kImplicit;
   Tether t = Make(p, env);
   ASSERT_TRUE(t.params().effects & kSeabed);
   const double k = 2e5 * L0 / 2, c = 300 * L0 / 2;  // [N/m], [N s/m]
