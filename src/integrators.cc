@@ -1086,6 +1086,8 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
     // start of the step; implicit: the last Newton iterate; rk4: the last stage).
     const ConstNodes f(Work(work, N_).f, 3, n);
     status.work_a += f.col(0).dot(next.a.pos - now.a.pos);
+    status.end_impulse_a += h * Vec3(f.col(0));
+    status.end_impulse_b += h * Vec3(f.col(N_));
     // explicit with a body at end B (the consistent coupling): end A's impulse over the
     // substeps, each of which took the force at its start (plugin: end A's force is its mean).
     if (ExplicitWithBody(next)) {

@@ -108,6 +108,10 @@ struct StepStatus {
   // sum over tether steps of the end node's force (at the step's evaluation) times the end's
   // displacement. What the tether gave the bodies, for the coupling's work balance.
   double work_a = 0, work_b = 0;
+  // [N s] The impulse of those same forces over the advance (the sum over tether steps of the
+  // end node's force times the step): with work_a and work_b, the balance in the frame moving
+  // with the site, where a body's drift does not multiply the held force's lag (plugin.cc).
+  Vec3 end_impulse_a = Vec3::Zero(), end_impulse_b = Vec3::Zero();
   // [N s] With end B dynamic (WithDynamicEndB), for the schemes whose end A force at the end
   // of the step is not what their nodes' momentum took: the impulse of the tether's force on
   // end A over the advance as the scheme integrates it. implicit2: (1 - gamma) h and gamma h

@@ -227,6 +227,8 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
     // fuzzer's world draw, session 15: seeds 105, 276, 300, 489, 560, 756).
     const ConstNodes f(Work(work, view.N_).f, 3, na);
     status.work_a += f.col(0).dot(next.a.pos - now.a.pos);
+    status.end_impulse_a += h * Vec3(f.col(0));
+    status.end_impulse_b += h * Vec3(f.col(na - 1));
     // explicit with a body at end B (the consistent coupling): end A's impulse over the
     // substeps, as Advance without a winch sums it (the plugin reports its mean).
     if (ExplicitWithBody(next)) {
