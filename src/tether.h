@@ -112,14 +112,18 @@ struct StepStatus {
   // end node's force times the step): with work_a and work_b, the balance in the frame moving
   // with the site, where a body's drift does not multiply the held force's lag (plugin.cc).
   Vec3 end_impulse_a = Vec3::Zero(), end_impulse_b = Vec3::Zero();
-  // [N s] With end B dynamic (WithDynamicEndB), for the schemes whose end A force at the end
-  // of the step is not what their nodes' momentum took: the impulse of the tether's force on
-  // end A over the advance as the scheme integrates it. implicit2: (1 - gamma) h and gamma h
-  // times the force at its two stages (h times the force at the end of a backward-Euler step
-  // where it falls back); explicit: h times the force at the start of each substep. Set with
-  // has_impulse_a; EvaluateLead then reports end A's force as impulse_a over the advance.
-  Vec3 impulse_a = Vec3::Zero();
-  bool has_impulse_a = false;
+  // [N s] For the schemes whose end forces at the end of the step are not what their nodes'
+  // momentum took: the impulse of the tether's force on each attached end over the advance as
+  // the scheme integrates it. implicit2: (1 - gamma) h and gamma h times the force at its two
+  // stages (h times the force at the end of a backward-Euler step where it falls back), on
+  // both ends (end B only where it is held: a site's path, not the body's node); explicit with
+  // a body at end B (WithDynamicEndB): end A, h times the force at the start of each substep.
+  // Set with has_impulse_a, has_impulse_b; EvaluateLead then reports end A's force as
+  // impulse_a over the advance, and a held end's force is its impulse's mean carried to the
+  // advance's end (plugin.cc, HeldMean). Without contact forces (the plugin adds each end
+  // node's contact share apart).
+  Vec3 impulse_a = Vec3::Zero(), impulse_b = Vec3::Zero();
+  bool has_impulse_a = false, has_impulse_b = false;
 };
 
 // Options and outcome of Tether::RelaxToStatic (docs/static_start.md).
@@ -445,6 +449,10 @@ class Tether {
 
   void Sdirk2Step(Nodes x, Nodes v, const Ends& now, const Ends& next, double h,
                   double* work, StepStatus* stats) const;
+  // implicit2: adds weight_h times the end forces at the state x, v with the ends e to the
+  // advance's impulses (StepStatus::impulse_a, impulse_b).
+  void AddEndImpulse(const double* x, const double* v, const Ends& e, double weight_h,
+                     double* work, StepStatus* stats) const;
   // The BDF2 history of the nodes being stepped (a Deployed view's nodes): the step that made
   // the state [s] (0: none) and the change of x and v over it (3 x n).
   struct History {
