@@ -423,16 +423,23 @@ TEST(Sweep, ProgressBarOnlyOnATerminal) {
 }
 
 // SIGTERM stops the sweep and its running rows: exit 143, the rows stopped are not recorded
-// as done (summary: pending), so that a resume runs them again.
+// as done (summary: pending), so that a resume runs them again. The signal is sent once both
+// rows have started (their stderr files exist: the sweep handles signals from before the first
+// row starts), not after a fixed second: under ASan on a loaded machine (session 40's CI, with
+// two builds beside it) a second was not enough to reach the rows, and the default action of
+// SIGTERM ended the sweep before it had a summary to write.
 TEST(Sweep, InterruptedRowsAreNotDone) {
   const std::string dir = TempFolder("interrupt");
   MakeManifest(dir);
   Write(dir + "/manifest.csv",
         "model,duration\nmodels/rov_tether.xml,600\nmodels/rov_tether.xml,600\n");
   std::string output;
+  const std::string started = "[ -e " + dir + "/out/1.stderr.txt ] && [ -e " + dir +
+                              "/out/2.stderr.txt ]";
   const int status =
       RunShell(std::string(MJTETHER_CLI) + " sweep " + dir + "/manifest.csv --out " + dir +
-                   "/out --jobs 2 --every 10 & sleep 1; kill -TERM $!; wait $!",
+                   "/out --jobs 2 --every 10 & i=0; while [ $i -lt 1200 ] && ! { " + started +
+                   "; }; do sleep 0.05; i=$((i+1)); done; sleep 0.2; kill -TERM $!; wait $!",
                &output);
   EXPECT_EQ(status, 143) << output;
   EXPECT_TRUE(Contains(output, "interrupted; 2 rows, 0 ok, 2 not ok")) << output;
