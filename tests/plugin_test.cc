@@ -157,53 +157,34 @@ std::string DefaultModel() {
   return s.str();
 }
 
-// The default scene with its tether on `integrator`: implicit2 holds the vehicle's end with its
-// stages' mean carried through the advance before's (plugin.cc, HeldMean; session 40), state
-// that copies and resets must carry like the nodes'.
-std::string DefaultModelWith(const char* integrator) {
-  std::string xml = DefaultModel();
-  const std::string key = "integrator=implicit";
-  const size_t at = xml.find(key);
-  if (at != std::string::npos) xml.replace(at, key.size(), std::string("integrator=") + integrator);
-  return xml;
-}
-
 // mj_copyData carries the tether: a copy stepped on reproduces the original bit for bit.
 TEST_F(MuJoCoTest, CopyDataRolloutIsBitForBit) {
-  for (const char* integrator : {"implicit", "implicit2"}) {
-    mjModel* m = Load(DefaultModelWith(integrator));
-    ASSERT_NE(m, nullptr) << integrator;
-    mjData* d = Make(m);
-    for (int k = 0; k < 250; ++k) mj_step(m, d);
-    mjData* copy = Make(m);
-    mj_copyData(copy, m, d);
-    for (int k = 0; k < 250; ++k) {
-      mj_step(m, d);
-      mj_step(m, copy);
-    }
-    EXPECT_EQ(std::memcmp(d->qpos, copy->qpos, sizeof(mjtNum) * m->nq), 0) << integrator;
-    EXPECT_EQ(std::memcmp(d->qvel, copy->qvel, sizeof(mjtNum) * m->nv), 0) << integrator;
-    EXPECT_EQ(std::memcmp(d->userdata, copy->userdata, sizeof(mjtNum) * m->nuserdata), 0)
-        << integrator;
+  mjModel* m = Load(DefaultModel());
+  mjData* d = Make(m);
+  for (int k = 0; k < 250; ++k) mj_step(m, d);
+  mjData* copy = Make(m);
+  mj_copyData(copy, m, d);
+  for (int k = 0; k < 250; ++k) {
+    mj_step(m, d);
+    mj_step(m, copy);
   }
+  EXPECT_EQ(std::memcmp(d->qpos, copy->qpos, sizeof(mjtNum) * m->nq), 0);
+  EXPECT_EQ(std::memcmp(d->qvel, copy->qvel, sizeof(mjtNum) * m->nv), 0);
+  EXPECT_EQ(std::memcmp(d->userdata, copy->userdata, sizeof(mjtNum) * m->nuserdata), 0);
 }
 
 // mj_resetData re-initialises the tether from its declared shape: a run after a reset
 // reproduces the first run bit for bit.
 TEST_F(MuJoCoTest, ResetReproducesTheRun) {
-  for (const char* integrator : {"implicit", "implicit2"}) {
-    mjModel* m = Load(DefaultModelWith(integrator));
-    ASSERT_NE(m, nullptr) << integrator;
-    mjData* d = Make(m);
-    for (int k = 0; k < 200; ++k) mj_step(m, d);
-    std::vector<mjtNum> qpos(d->qpos, d->qpos + m->nq);
-    std::vector<mjtNum> user(d->userdata, d->userdata + m->nuserdata);
-    mj_resetData(m, d);
-    for (int k = 0; k < 200; ++k) mj_step(m, d);
-    EXPECT_EQ(std::memcmp(qpos.data(), d->qpos, sizeof(mjtNum) * m->nq), 0) << integrator;
-    EXPECT_EQ(std::memcmp(user.data(), d->userdata, sizeof(mjtNum) * m->nuserdata), 0)
-        << integrator;
-  }
+  mjModel* m = Load(DefaultModel());
+  mjData* d = Make(m);
+  for (int k = 0; k < 200; ++k) mj_step(m, d);
+  std::vector<mjtNum> qpos(d->qpos, d->qpos + m->nq);
+  std::vector<mjtNum> user(d->userdata, d->userdata + m->nuserdata);
+  mj_resetData(m, d);
+  for (int k = 0; k < 200; ++k) mj_step(m, d);
+  EXPECT_EQ(std::memcmp(qpos.data(), d->qpos, sizeof(mjtNum) * m->nq), 0);
+  EXPECT_EQ(std::memcmp(user.data(), d->userdata, sizeof(mjtNum) * m->nuserdata), 0);
 }
 
 // A second evaluation at the same time (mj_forward again, as RK4 and user code do) changes
