@@ -1122,14 +1122,15 @@ StepStatus Tether::Advance(double* xp, double* vp, const Ends& from, const Ends&
     status.work_a += f.col(0).dot(next.a.pos - now.a.pos);
     status.end_impulse_a += h * Vec3(f.col(0));
     status.end_impulse_b += h * Vec3(f.col(N_));
-    // explicit with a body at end B (the consistent coupling): end A's impulse over the
-    // substeps, each of which took the force at its start (plugin: end A's force is its mean).
-    if (ExplicitWithBody(next)) {
-      status.impulse_a += h * Vec3(f.col(0));
-      status.has_impulse_a = true;
-    }
     if (!DynamicB()) status.work_b += f.col(N_).dot(next.b.pos - now.b.pos);
     now = next;
+  }
+  // explicit with a body at end B (the consistent coupling): end A's impulse over the substeps,
+  // each of which took the force at its start, is the plugin's end A force (its mean). Every
+  // substep's `next` carries to.body_b (Interpolate), so this is the sum above.
+  if (ExplicitWithBody(to)) {
+    status.impulse_a = status.end_impulse_a;
+    status.has_impulse_a = true;
   }
   Check(ConstNodes(xp, 3, n), ConstNodes(vp, 3, n), from, to, &status);
   return status;
