@@ -7,6 +7,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
 #include <optional>
 #include <string>
@@ -93,6 +94,35 @@ class MuJoCoFixture : public ::testing::Test {
     mjData* d = mj_makeData(m);
     datas_.push_back(d);
     return d;
+  }
+  // mj_copyData carries the tether: a copy of a run's state after 250 steps, stepped on beside
+  // it, reproduces it bit for bit (qpos, qvel and the tether's userdata block), which has not
+  // diverged.
+  void ExpectCopyIsBitIdentical(mjModel* m) {
+    mjData* d = Make(m);
+    for (int k = 0; k < 250; ++k) mj_step(m, d);
+    mjData* copy = Make(m);
+    mj_copyData(copy, m, d);
+    for (int k = 0; k < 250; ++k) {
+      mj_step(m, d);
+      mj_step(m, copy);
+    }
+    EXPECT_EQ(std::memcmp(d->qpos, copy->qpos, sizeof(mjtNum) * m->nq), 0);
+    EXPECT_EQ(std::memcmp(d->qvel, copy->qvel, sizeof(mjtNum) * m->nv), 0);
+    EXPECT_EQ(std::memcmp(d->userdata, copy->userdata, sizeof(mjtNum) * m->nuserdata), 0);
+    EXPECT_FALSE(CheckDivergence(m, d).has_value());
+  }
+  // mj_resetData re-initialises the tether from its declared shape: 200 steps after a reset
+  // reproduce the first 200 bit for bit (qpos and the tether's userdata block).
+  void ExpectResetIsBitIdentical(mjModel* m) {
+    mjData* d = Make(m);
+    for (int k = 0; k < 200; ++k) mj_step(m, d);
+    std::vector<mjtNum> qpos(d->qpos, d->qpos + m->nq);
+    std::vector<mjtNum> user(d->userdata, d->userdata + m->nuserdata);
+    mj_resetData(m, d);
+    for (int k = 0; k < 200; ++k) mj_step(m, d);
+    EXPECT_EQ(std::memcmp(qpos.data(), d->qpos, sizeof(mjtNum) * m->nq), 0);
+    EXPECT_EQ(std::memcmp(user.data(), d->userdata, sizeof(mjtNum) * m->nuserdata), 0);
   }
   std::vector<mjModel*> models_;
   std::vector<mjData*> datas_;

@@ -160,31 +160,14 @@ std::string DefaultModel() {
 // mj_copyData carries the tether: a copy stepped on reproduces the original bit for bit.
 TEST_F(MuJoCoTest, CopyDataRolloutIsBitForBit) {
   mjModel* m = Load(DefaultModel());
-  mjData* d = Make(m);
-  for (int k = 0; k < 250; ++k) mj_step(m, d);
-  mjData* copy = Make(m);
-  mj_copyData(copy, m, d);
-  for (int k = 0; k < 250; ++k) {
-    mj_step(m, d);
-    mj_step(m, copy);
-  }
-  EXPECT_EQ(std::memcmp(d->qpos, copy->qpos, sizeof(mjtNum) * m->nq), 0);
-  EXPECT_EQ(std::memcmp(d->qvel, copy->qvel, sizeof(mjtNum) * m->nv), 0);
-  EXPECT_EQ(std::memcmp(d->userdata, copy->userdata, sizeof(mjtNum) * m->nuserdata), 0);
+  ExpectCopyIsBitIdentical(m);
 }
 
 // mj_resetData re-initialises the tether from its declared shape: a run after a reset
 // reproduces the first run bit for bit.
 TEST_F(MuJoCoTest, ResetReproducesTheRun) {
   mjModel* m = Load(DefaultModel());
-  mjData* d = Make(m);
-  for (int k = 0; k < 200; ++k) mj_step(m, d);
-  std::vector<mjtNum> qpos(d->qpos, d->qpos + m->nq);
-  std::vector<mjtNum> user(d->userdata, d->userdata + m->nuserdata);
-  mj_resetData(m, d);
-  for (int k = 0; k < 200; ++k) mj_step(m, d);
-  EXPECT_EQ(std::memcmp(qpos.data(), d->qpos, sizeof(mjtNum) * m->nq), 0);
-  EXPECT_EQ(std::memcmp(user.data(), d->userdata, sizeof(mjtNum) * m->nuserdata), 0);
+  ExpectResetIsBitIdentical(m);
 }
 
 // A second evaluation at the same time (mj_forward again, as RK4 and user code do) changes
