@@ -1407,13 +1407,14 @@ Twin JudgeTwin(const Scene& twin, double duration, const std::string& label,
 // (session 40's tuned failures 1910, 2143, 4435, 5805, 7637, 7808, 8253, 8945, 9016 and 9037,
 // stretched starts whose unstretched twins rang: 2143's read 2.85 N at 2 ms, 147 N at 0.2 ms
 // and 233 N at 0.02 ms). The twin with damping_ratio=1 as well, both warned causes taken away,
-// is judged like any twin (all but 1910 and 9037 agree so); without a ring warning nothing is
-// judged (agrees false, no detail).
+// is judged like any twin (all but 1910 and 9037 agree so); without a ring warning, or without
+// a twin (its xml empty: the one-cause twin's detail already says why), nothing is judged
+// (agrees false, no detail).
 Twin JudgeWithDampingToo(const Scene& twin, const Run& coarse, const std::string& label,
                          std::string Run::*warning) {
-  if (coarse.ring_warning.empty()) return {};
-  return JudgeTwin(twin.xml.empty() ? twin : Damped(twin), coarse.duration,
-                   label + ", with damping_ratio=1", "no twin", {warning, &Run::ring_warning});
+  if (coarse.ring_warning.empty() || twin.xml.empty()) return {};
+  return JudgeTwin(Damped(twin), coarse.duration, label + ", with damping_ratio=1",
+                   "the declaration is not the fuzzer's", {warning, &Run::ring_warning});
 }
 
 Outcome JudgeRuns(const Scene& s) {
@@ -1601,9 +1602,8 @@ Outcome JudgeRuns(const Scene& s) {
     const Twin c = JudgeTwin(cleared, coarse.duration, "geom moved clear",
                              "no place keeps the ends clear", {&Run::contact_warning});
     if (c.agrees) return {kWarnedInside, true, o.kind + ": " + o.detail + c.detail};
-    const Twin d = cleared.xml.empty() ? Twin{}
-                                       : JudgeWithDampingToo(cleared, coarse, "geom moved clear",
-                                                             &Run::contact_warning);
+    const Twin d =
+        JudgeWithDampingToo(cleared, coarse, "geom moved clear", &Run::contact_warning);
     if (d.agrees) {
       return {kWarnedInsideRing, true, o.kind + ": " + o.detail + c.detail + d.detail};
     }
