@@ -99,6 +99,7 @@ class MuJoCoFixture : public ::testing::Test {
   // it, reproduces it bit for bit (qpos, qvel and the tether's userdata block), which has not
   // diverged.
   void ExpectCopyIsBitIdentical(mjModel* m) {
+    ASSERT_NE(m, nullptr);
     mjData* d = Make(m);
     for (int k = 0; k < 250; ++k) mj_step(m, d);
     mjData* copy = Make(m);
@@ -115,6 +116,7 @@ class MuJoCoFixture : public ::testing::Test {
   // mj_resetData re-initialises the tether from its declared shape: 200 steps after a reset
   // reproduce the first 200 bit for bit (qpos and the tether's userdata block).
   void ExpectResetIsBitIdentical(mjModel* m) {
+    ASSERT_NE(m, nullptr);
     mjData* d = Make(m);
     for (int k = 0; k < 200; ++k) mj_step(m, d);
     std::vector<mjtNum> qpos(d->qpos, d->qpos + m->nq);
