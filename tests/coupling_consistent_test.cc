@@ -349,6 +349,102 @@ TEST_F(LightVehicle, HeavilyDampedEndTakesTheConsistentCouplingAndAgreesWithItsF
   }
 }
 
+// The converse (session 42): a stiff end damper on a stiff end, where the consistent coupling's
+// step would damp the body-end mode more than the damper does. The scene fuzzer's held-out seed
+// 12117 with damping_ratio=1, as its ringing warning advises: bdf2, 41 segments of 4.6 m, EA
+// 4.2e7 N, a 101 kg vehicle (m_eff 170 kg) at the end of a line started 0.035% stretched under
+// a surging TMS, which rings in tension and compression (EAc = EA). h (damping/L0)/m_eff =
+// 0.0995 at 2 ms, above kLeadFromDamping's 0.025, took the consistent coupling until session 41,
+// whose backward-Euler step damps the body-end mode (omega h 0.465) by a ratio of about 0.23
+// against the damper's 0.107: the vehicle-end tension over 0.8-1 s read 948 N against 1096 N at
+// 0.2 ms (13.5% low). The held force reads 1096.2 N. Asserted: the held force at 2 ms (kappa
+// z^2 = 0.216 > d), the 0.8-1 s mean tension within 2% of the 0.2 ms run's (the held force
+// there too: d = 0.00995), and the vehicle within 1 cm of it all along.
+TEST_F(LightVehicle, StiffEndDamperKeepsTheHeldForceWhereTheCouplingStepDampsTheEndMode) {
+  auto xml = [&](double h) {
+    return std::string("<mujoco><option timestep=\"") + std::to_string(h) +
+           R"("/><custom>
+<text name="water" data="density=1025 seabed=-80.92116886"/>
+<text name="vehicle:rov" data="volume=0.1015651269 cob=0,0,0.04659858662 added_mass=71.78478104,86.55343971,68.43171852,1.098585155,1.098585155,1.098585155 linear_damping=30.76945686,30.76945686,30.76945686,3.661950516,3.661950516,3.661950516 quadratic_damping=111.2856991,111.2856991,111.2856991,3.661950516,3.661950516,3.661950516 coriolis=0"/>
+<text name="tether:t" data="ends=tms_site,att length=186.7842495 segments=41 diameter=0.0345260913 mass_per_length=1.70435855 EA=41779652.34 Cdn=1.2 Cdt=0.01 Can=1 integrator=bdf2 EI=0.001565500825 EAc=41779652.34 damping_ratio=1"/>
+<text name="motion:tms" data="x=0.4101341135,4.168716106,0"/>
+</custom><worldbody>
+<body name="tms" mocap="true"><site name="tms_site"/></body>
+<body name="rov" pos="162.6944743 47.75978518 -78.49782678"><freejoint/><inertial pos="0 0 0" mass="101.1854886" diaginertia="3.661950516 3.661950516 3.661950516"/><site name="att"/></body>
+</worldbody></mujoco>)";
+  };
+  auto mean_tension = [](const std::vector<Sample>& run, double from) {
+    double sum = 0;
+    int n = 0;
+    for (const Sample& s : run) {
+      if (s.t > from + 1e-9) sum += s.tension, ++n;
+    }
+    return n > 0 ? sum / n : NAN;
+  };
+  std::string stopped;
+  mjModel* m = Load(xml(0.002), "damped_end.xml");
+  ASSERT_NE(m, nullptr);
+  const CouplingLimit c = GetCouplingLimit(m, 0, 1);
+  EXPECT_GE(c.damping_h, 0.025);                    // a stiff damper on the body's step
+  EXPECT_GT(c.omega_h * c.omega_h, c.damping_h);    // kappa z^2 > d (kappa 1 with bdf2)
+  EXPECT_LT(c.omega_h, 1.0);                        // below bdf2's own kLeadFrom
+  EXPECT_FALSE(c.consistent) << "h damping/(L0 m_eff) = " << c.damping_h;
+  const std::vector<Sample> got = RunScene(m, 1.0, &stopped, 0.002);
+  ASSERT_EQ(stopped, "");
+  mjModel* fine = Load(xml(0.0002), "damped_end_fine.xml");
+  ASSERT_NE(fine, nullptr);
+  EXPECT_FALSE(GetCouplingLimit(fine, 0, 1).consistent);
+  const std::vector<Sample> ref = RunScene(fine, 1.0, &stopped, 0.002);
+  ASSERT_EQ(stopped, "");
+  ASSERT_EQ(got.size(), ref.size());
+  const double T = mean_tension(got, 0.8), T_ref = mean_tension(ref, 0.8);
+  const Agreement a = Compare(got, ref, 0.8);
+  std::printf("0.8-1 s mean tension %.2f N against %.2f N; vehicle %.2f mm off at most\n", T,
+              T_ref, a.position * 1e3);
+  EXPECT_NEAR(T, T_ref, 0.02 * T_ref);
+  EXPECT_LT(a.position, 0.01);
+}
+
+// Where the damper is very stiff on the body's step the consistent coupling stays, whatever the
+// mode (kHeldDamperMax, session 42): held-out seed 14719 (bdf2 stepping as backward Euler, 58
+// segments of 7.5 cm, EA 1.1e5 N, damping 174 N s, a 5.7 kg vehicle, m_eff 8.5 kg, in a 1 m/s
+// current above a seabed): d = h (damping/L0)/m_eff = 0.546 and kappa z^2 = 0.674 at 2 ms. With
+// the held force (the end-mode rule alone) the vehicle ended 157 mm off its 0.2 ms self; with
+// the consistent coupling 4 mm. Asserted: consistent at 2 ms and at 0.2 ms (d 0.055 >= kappa
+// z^2 0.0067), and the vehicle within 2 cm of the 0.2 ms run over 1 s.
+TEST_F(LightVehicle, VeryStiffEndDamperTakesTheConsistentCouplingWhateverTheEndMode) {
+  auto xml = [&](double h) {
+    return std::string("<mujoco><option timestep=\"") + std::to_string(h) +
+           R"("/><custom>
+<text name="water" data="density=1025 current=0.463377746,-0.9192537855,0 seabed=-6.30335659"/>
+<text name="vehicle:rov" data="volume=0.005453290432 cob=0,0,0.01787412872 added_mass=3.301560486,2.753246519,5.375843631,0.009122091198,0.009122091198,0.009122091198 linear_damping=5.539920473,5.539920473,5.539920473,0.03040697066,0.03040697066,0.03040697066 quadratic_damping=16.37357947,16.37357947,16.37357947,0.03040697066,0.03040697066,0.03040697066 coriolis=0"/>
+<text name="tether:t" data="ends=tms_site,att length=4.356424131 segments=58 diameter=0.009305492068 mass_per_length=0.1998870648 EA=107143.5176 Cdn=1.2 Cdt=0.01 Can=1 integrator=bdf2 EI=97.17614585 EAc=107143.5176 damping=173.580024"/>
+</custom><worldbody>
+<body name="tms" mocap="true"><site name="tms_site"/></body>
+<body name="rov" pos="-0.9190841202 0.1216740898 -2.014500156"><freejoint/><inertial pos="0 0 0" mass="5.710506672" diaginertia="0.03040697066 0.03040697066 0.03040697066"/><site name="att"/></body>
+</worldbody></mujoco>)";
+  };
+  std::string stopped;
+  mjModel* m = Load(xml(0.002), "very_damped_end.xml");
+  ASSERT_NE(m, nullptr);
+  const CouplingLimit c = GetCouplingLimit(m, 0, 1);
+  EXPECT_GT(c.omega_h * c.omega_h, c.damping_h);  // the end-mode rule alone would hold it
+  EXPECT_GE(c.damping_h, 0.25);
+  EXPECT_TRUE(c.consistent) << "h damping/(L0 m_eff) = " << c.damping_h;
+  const std::vector<Sample> got = RunScene(m, 1.0, &stopped, 0.01);
+  ASSERT_EQ(stopped, "");
+  mjModel* fine = Load(xml(0.0002), "very_damped_end_fine.xml");
+  ASSERT_NE(fine, nullptr);
+  EXPECT_TRUE(GetCouplingLimit(fine, 0, 1).consistent);
+  const std::vector<Sample> ref = RunScene(fine, 1.0, &stopped, 0.01);
+  ASSERT_EQ(stopped, "");
+  ASSERT_EQ(got.size(), ref.size());
+  const Agreement a = Compare(got, ref, 0.8);
+  std::printf("vehicle %.2f mm off at most, tension %.2f%% from 0.8 s\n", a.position * 1e3,
+              100 * a.tension);
+  EXPECT_LT(a.position, 0.02);
+}
+
 // The momentum balance of a free body at end B of a tether anchored at end A (no gravity, no
 // water): the body starts at (10.001, 0, 0) moving 0.1 m/s away from the anchor; after a first
 // step (which sets the initial shape and, with bdf2, its history), 250 more steps. Nothing but
