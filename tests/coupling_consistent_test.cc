@@ -60,6 +60,31 @@ class LightVehicle : public testing::MuJoCoFixture {
     return {Oscillate(xml("0.002"), name, axis, from, until),
             Oscillate(xml("0.0001"), name, axis, from, until)};
   }
+  // A scene at the 2 ms step and at 0.2 ms (the reference), xml(step) giving its MJCF: the
+  // coupling each run took at end B and its samples every `interval` s over `duration` s (the
+  // test fails where a scene does not load or a run stops).
+  struct StepPair {
+    CouplingLimit coarse, fine;
+    std::vector<Sample> got, ref;
+  };
+  template <typename Xml>
+  StepPair AtTwoSteps(Xml xml, const char* name, double duration, double interval) {
+    StepPair p;
+    mjModel* coarse = Load(xml(0.002), name);
+    mjModel* fine = Load(xml(0.0002), name);
+    EXPECT_NE(coarse, nullptr);
+    EXPECT_NE(fine, nullptr);
+    if (!coarse || !fine) return p;
+    p.coarse = GetCouplingLimit(coarse, 0, 1);
+    p.fine = GetCouplingLimit(fine, 0, 1);
+    std::string stopped;
+    p.got = RunScene(coarse, duration, &stopped, interval);
+    EXPECT_EQ(stopped, "") << "at 2 ms";
+    p.ref = RunScene(fine, duration, &stopped, interval);
+    EXPECT_EQ(stopped, "") << "at 0.2 ms";
+    EXPECT_EQ(p.got.size(), p.ref.size());
+    return p;
+  }
   // The bounce tests' scene (below) with a body of mass [kg] started at x = pos [m]: its
   // amplitude over 0.4-0.5 s at 2 ms within tolerance (relative) of the 0.1 ms run's.
   void ExpectBounceHeld(const char* integrator, const char* mass, const char* pos,
@@ -381,24 +406,16 @@ TEST_F(LightVehicle, StiffEndDamperKeepsTheHeldForceWhereTheCouplingStepDampsThe
     }
     return n > 0 ? sum / n : NAN;
   };
-  std::string stopped;
-  mjModel* m = Load(xml(0.002), "damped_end.xml");
-  ASSERT_NE(m, nullptr);
-  const CouplingLimit c = GetCouplingLimit(m, 0, 1);
-  EXPECT_GE(c.damping_h, 0.025);                    // a stiff damper on the body's step
-  EXPECT_GT(c.omega_h * c.omega_h, c.damping_h);    // kappa z^2 > d (kappa 1 with bdf2)
-  EXPECT_LT(c.omega_h, 1.0);                        // below bdf2's own kLeadFrom
+  const StepPair p = AtTwoSteps(xml, "damped_end.xml", 1.0, 0.002);
+  const CouplingLimit& c = p.coarse;
+  EXPECT_GE(c.damping_h, 0.025);                  // a stiff damper on the body's step
+  EXPECT_GT(c.omega_h * c.omega_h, c.damping_h);  // kappa z^2 > d (kappa 1 with bdf2)
+  EXPECT_LT(c.omega_h, 1.0);                      // below bdf2's own kLeadFrom
   EXPECT_FALSE(c.consistent) << "h damping/(L0 m_eff) = " << c.damping_h;
-  const std::vector<Sample> got = RunScene(m, 1.0, &stopped, 0.002);
-  ASSERT_EQ(stopped, "");
-  mjModel* fine = Load(xml(0.0002), "damped_end_fine.xml");
-  ASSERT_NE(fine, nullptr);
-  EXPECT_FALSE(GetCouplingLimit(fine, 0, 1).consistent);
-  const std::vector<Sample> ref = RunScene(fine, 1.0, &stopped, 0.002);
-  ASSERT_EQ(stopped, "");
-  ASSERT_EQ(got.size(), ref.size());
-  const double T = mean_tension(got, 0.8), T_ref = mean_tension(ref, 0.8);
-  const Agreement a = Compare(got, ref, 0.8);
+  EXPECT_FALSE(p.fine.consistent);
+  ASSERT_FALSE(p.got.empty());
+  const double T = mean_tension(p.got, 0.8), T_ref = mean_tension(p.ref, 0.8);
+  const Agreement a = Compare(p.got, p.ref, 0.8);
   std::printf("0.8-1 s mean tension %.2f N against %.2f N; vehicle %.2f mm off at most\n", T,
               T_ref, a.position * 1e3);
   EXPECT_NEAR(T, T_ref, 0.02 * T_ref);
@@ -424,22 +441,14 @@ TEST_F(LightVehicle, VeryStiffEndDamperTakesTheConsistentCouplingWhateverTheEndM
 <body name="rov" pos="-0.9190841202 0.1216740898 -2.014500156"><freejoint/><inertial pos="0 0 0" mass="5.710506672" diaginertia="0.03040697066 0.03040697066 0.03040697066"/><site name="att"/></body>
 </worldbody></mujoco>)";
   };
-  std::string stopped;
-  mjModel* m = Load(xml(0.002), "very_damped_end.xml");
-  ASSERT_NE(m, nullptr);
-  const CouplingLimit c = GetCouplingLimit(m, 0, 1);
+  const StepPair p = AtTwoSteps(xml, "very_damped_end.xml", 1.0, 0.01);
+  const CouplingLimit& c = p.coarse;
   EXPECT_GT(c.omega_h * c.omega_h, c.damping_h);  // the end-mode rule alone would hold it
   EXPECT_GE(c.damping_h, 0.25);
   EXPECT_TRUE(c.consistent) << "h damping/(L0 m_eff) = " << c.damping_h;
-  const std::vector<Sample> got = RunScene(m, 1.0, &stopped, 0.01);
-  ASSERT_EQ(stopped, "");
-  mjModel* fine = Load(xml(0.0002), "very_damped_end_fine.xml");
-  ASSERT_NE(fine, nullptr);
-  EXPECT_TRUE(GetCouplingLimit(fine, 0, 1).consistent);
-  const std::vector<Sample> ref = RunScene(fine, 1.0, &stopped, 0.01);
-  ASSERT_EQ(stopped, "");
-  ASSERT_EQ(got.size(), ref.size());
-  const Agreement a = Compare(got, ref, 0.8);
+  EXPECT_TRUE(p.fine.consistent);
+  ASSERT_FALSE(p.got.empty());
+  const Agreement a = Compare(p.got, p.ref, 0.8);
   std::printf("vehicle %.2f mm off at most, tension %.2f%% from 0.8 s\n", a.position * 1e3,
               100 * a.tension);
   EXPECT_LT(a.position, 0.02);
