@@ -60,18 +60,21 @@ class LightVehicle : public testing::MuJoCoFixture {
     return {Oscillate(xml("0.002"), name, axis, from, until),
             Oscillate(xml("0.0001"), name, axis, from, until)};
   }
-  // A scene at the 2 ms step and at 0.2 ms (the reference), xml(step) giving its MJCF: the
-  // coupling each run took at end B and its samples every `interval` s over `duration` s (the
-  // test fails where a scene does not load or a run stops).
+  // A scene at the 2 ms step and at 0.2 ms (the reference), `scene` its MJCF after the
+  // <option> element: the coupling each run took at end B and its samples every `interval` s
+  // over `duration` s (the test fails where a scene does not load or a run stops).
   struct StepPair {
     CouplingLimit coarse, fine;
     std::vector<Sample> got, ref;
   };
-  template <typename Xml>
-  StepPair AtTwoSteps(Xml xml, const char* name, double duration, double interval) {
+  StepPair AtTwoSteps(const std::string& scene, const char* name, double duration,
+                      double interval) {
     StepPair p;
-    mjModel* coarse = Load(xml(0.002), name);
-    mjModel* fine = Load(xml(0.0002), name);
+    auto at = [&](const char* step) {
+      return Load(std::string("<mujoco><option timestep=\"") + step + "\"/>" + scene, name);
+    };
+    mjModel* coarse = at("0.002");
+    mjModel* fine = at("0.0002");
     EXPECT_NE(coarse, nullptr);
     EXPECT_NE(fine, nullptr);
     if (!coarse || !fine) return p;
@@ -386,9 +389,7 @@ TEST_F(LightVehicle, HeavilyDampedEndTakesTheConsistentCouplingAndAgreesWithItsF
 // z^2 = 0.216 > d), the 0.8-1 s mean tension within 2% of the 0.2 ms run's (the held force
 // there too: d = 0.00995), and the vehicle within 1 cm of it all along.
 TEST_F(LightVehicle, StiffEndDamperKeepsTheHeldForceWhereTheCouplingStepDampsTheEndMode) {
-  auto xml = [&](double h) {
-    return std::string("<mujoco><option timestep=\"") + std::to_string(h) +
-           R"("/><custom>
+  const std::string scene = R"(<custom>
 <text name="water" data="density=1025 seabed=-80.92116886"/>
 <text name="vehicle:rov" data="volume=0.1015651269 cob=0,0,0.04659858662 added_mass=71.78478104,86.55343971,68.43171852,1.098585155,1.098585155,1.098585155 linear_damping=30.76945686,30.76945686,30.76945686,3.661950516,3.661950516,3.661950516 quadratic_damping=111.2856991,111.2856991,111.2856991,3.661950516,3.661950516,3.661950516 coriolis=0"/>
 <text name="tether:t" data="ends=tms_site,att length=186.7842495 segments=41 diameter=0.0345260913 mass_per_length=1.70435855 EA=41779652.34 Cdn=1.2 Cdt=0.01 Can=1 integrator=bdf2 EI=0.001565500825 EAc=41779652.34 damping_ratio=1"/>
@@ -397,7 +398,6 @@ TEST_F(LightVehicle, StiffEndDamperKeepsTheHeldForceWhereTheCouplingStepDampsThe
 <body name="tms" mocap="true"><site name="tms_site"/></body>
 <body name="rov" pos="162.6944743 47.75978518 -78.49782678"><freejoint/><inertial pos="0 0 0" mass="101.1854886" diaginertia="3.661950516 3.661950516 3.661950516"/><site name="att"/></body>
 </worldbody></mujoco>)";
-  };
   auto mean_tension = [](const std::vector<Sample>& run, double from) {
     double sum = 0;
     int n = 0;
@@ -406,7 +406,7 @@ TEST_F(LightVehicle, StiffEndDamperKeepsTheHeldForceWhereTheCouplingStepDampsThe
     }
     return n > 0 ? sum / n : NAN;
   };
-  const StepPair p = AtTwoSteps(xml, "damped_end.xml", 1.0, 0.002);
+  const StepPair p = AtTwoSteps(scene, "damped_end.xml", 1.0, 0.002);
   const CouplingLimit& c = p.coarse;
   EXPECT_GE(c.damping_h, 0.025);                  // a stiff damper on the body's step
   EXPECT_GT(c.omega_h * c.omega_h, c.damping_h);  // kappa z^2 > d (kappa 1 with bdf2)
@@ -430,9 +430,7 @@ TEST_F(LightVehicle, StiffEndDamperKeepsTheHeldForceWhereTheCouplingStepDampsThe
 // the consistent coupling 4 mm. Asserted: consistent at 2 ms and at 0.2 ms (d 0.055 >= kappa
 // z^2 0.0067), and the vehicle within 2 cm of the 0.2 ms run over 1 s.
 TEST_F(LightVehicle, VeryStiffEndDamperTakesTheConsistentCouplingWhateverTheEndMode) {
-  auto xml = [&](double h) {
-    return std::string("<mujoco><option timestep=\"") + std::to_string(h) +
-           R"("/><custom>
+  const std::string scene = R"(<custom>
 <text name="water" data="density=1025 current=0.463377746,-0.9192537855,0 seabed=-6.30335659"/>
 <text name="vehicle:rov" data="volume=0.005453290432 cob=0,0,0.01787412872 added_mass=3.301560486,2.753246519,5.375843631,0.009122091198,0.009122091198,0.009122091198 linear_damping=5.539920473,5.539920473,5.539920473,0.03040697066,0.03040697066,0.03040697066 quadratic_damping=16.37357947,16.37357947,16.37357947,0.03040697066,0.03040697066,0.03040697066 coriolis=0"/>
 <text name="tether:t" data="ends=tms_site,att length=4.356424131 segments=58 diameter=0.009305492068 mass_per_length=0.1998870648 EA=107143.5176 Cdn=1.2 Cdt=0.01 Can=1 integrator=bdf2 EI=97.17614585 EAc=107143.5176 damping=173.580024"/>
@@ -440,8 +438,7 @@ TEST_F(LightVehicle, VeryStiffEndDamperTakesTheConsistentCouplingWhateverTheEndM
 <body name="tms" mocap="true"><site name="tms_site"/></body>
 <body name="rov" pos="-0.9190841202 0.1216740898 -2.014500156"><freejoint/><inertial pos="0 0 0" mass="5.710506672" diaginertia="0.03040697066 0.03040697066 0.03040697066"/><site name="att"/></body>
 </worldbody></mujoco>)";
-  };
-  const StepPair p = AtTwoSteps(xml, "very_damped_end.xml", 1.0, 0.01);
+  const StepPair p = AtTwoSteps(scene, "very_damped_end.xml", 1.0, 0.01);
   const CouplingLimit& c = p.coarse;
   EXPECT_GT(c.omega_h * c.omega_h, c.damping_h);  // the end-mode rule alone would hold it
   EXPECT_GE(c.damping_h, 0.25);

@@ -2015,12 +2015,14 @@ TEST(SceneFuzzOracle, ASnapIsMeasuredAgainstTheSmallerEndTension) {
   void (*previous)(const char*) = mju_user_warning;
   mju_user_warning = CountWarning;
   const Scene s = Make(6260, kDraw);
-  ASSERT_EQ(s.integrator, "implicit");
+  EXPECT_EQ(s.integrator, "implicit");
   const mjtether::Run run = Simulate(s, kStep);
-  ASSERT_TRUE(Contains(run.ring_warning, "largest axial wave tension jump ")) << run.ring_warning;
-  const std::string jump = run.ring_warning.substr(
-      run.ring_warning.find("largest axial wave tension jump ") + 32);
-  EXPECT_LT(std::stod(jump), 1.0) << run.ring_warning;
+  const std::string key = "largest axial wave tension jump ";
+  const size_t at = run.ring_warning.find(key);
+  EXPECT_NE(at, std::string::npos) << run.ring_warning;
+  if (at != std::string::npos) {
+    EXPECT_LT(std::stod(run.ring_warning.substr(at + key.size())), 1.0) << run.ring_warning;
+  }
   const Outcome warned = Judge(s);
   EXPECT_TRUE(warned.pass) << warned.kind << ": " << warned.detail;
   EXPECT_EQ(warned.kind, kWarnedRing);
