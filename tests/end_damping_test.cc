@@ -22,6 +22,7 @@
 
 #include "mjtether.h"
 #include "mjtether_vehicles.h"
+#include "warning_handler.h"
 
 namespace mjtether {
 namespace {
@@ -97,10 +98,8 @@ class EndDamping : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(EndDamping, AboveTheLimitSpeedStopsAtOnceWithTheAnalyticRate) {
   g_warnings = 0;
-  void (*previous)(const char*) = mju_user_warning;
-  mju_user_warning = CountWarning;
+  const testing::WarningHandler counting(CountWarning);
   const Outcome o = RunFrom(GetParam(), 1.25 * LimitSpeed());
-  mju_user_warning = previous;
   EXPECT_EQ(g_warnings, 0);
   ASSERT_TRUE(o.stopped);
   EXPECT_NE(o.message.find("damping too stiff for the step of body 'rov'"), std::string::npos)
@@ -114,10 +113,8 @@ TEST_P(EndDamping, AboveTheLimitSpeedStopsAtOnceWithTheAnalyticRate) {
 
 TEST_P(EndDamping, BelowTheLimitSpeedRunsWithoutAStopOrAWarning) {
   g_warnings = 0;
-  void (*previous)(const char*) = mju_user_warning;
-  mju_user_warning = CountWarning;
+  const testing::WarningHandler counting(CountWarning);
   const Outcome o = RunFrom(GetParam(), 0.8 * LimitSpeed());
-  mju_user_warning = previous;
   EXPECT_EQ(g_warnings, 0);
   EXPECT_FALSE(o.stopped) << o.message;
 }

@@ -88,6 +88,7 @@
 #include <vector>
 
 #include "mjtether.h"
+#include "warning_handler.h"
 
 namespace mjtether {
 namespace {
@@ -1719,8 +1720,7 @@ void RunScenes(const std::vector<SceneId>& list, const std::set<SceneId>& known,
                const char* known_file) {
   const long threads = std::max(1L, EnvLong("MJTETHER_SCENE_FUZZ_THREADS", 2));
   const bool verbose = EnvLong("MJTETHER_SCENE_FUZZ_VERBOSE", 0) != 0;
-  void (*previous)(const char*) = mju_user_warning;
-  mju_user_warning = CountWarning;
+  const testing::WarningHandler counting(CountWarning);
   std::mutex mutex;
   std::map<std::string, int> counts;
   std::vector<std::string> failures, known_failures, known_passing;
@@ -1763,7 +1763,6 @@ void RunScenes(const std::vector<SceneId>& list, const std::set<SceneId>& known,
   std::vector<std::thread> pool;
   for (long t = 0; t < threads; ++t) pool.emplace_back(worker);
   for (std::thread& t : pool) t.join();
-  mju_user_warning = previous;
 
   std::printf("%s", title);
   for (const auto& [kind, n] : counts) std::printf("  %5d  %s\n", n, kind.c_str());
@@ -1823,8 +1822,7 @@ TEST(SceneFuzz, TethersThatTouchGeomsOrWinchAreRefusedRunCorrectlyOrDivergeWithA
 // coupling limit is 0.5; seed 399, the one until session 13, agrees unstretched since
 // explicit's stable step was halved.)
 TEST(SceneFuzzOracle, AStretchedStartIsWarnedOnlyWhereItsUnstretchedTwinAgrees) {
-  void (*previous)(const char*) = mju_user_warning;
-  mju_user_warning = CountWarning;
+  const testing::WarningHandler counting(CountWarning);
   const Scene s = Make(644, kDraw);
   const mjtether::Run run = Simulate(s, kStep);
   ASSERT_TRUE(run.stretched);
@@ -1852,7 +1850,6 @@ TEST(SceneFuzzOracle, AStretchedStartIsWarnedOnlyWhereItsUnstretchedTwinAgrees) 
   const Outcome fine_ran = Judge(Make(12100, kDraw));
   EXPECT_TRUE(fine_ran.pass) << fine_ran.kind << ": " << fine_ran.detail;
   EXPECT_FALSE(Contains(fine_ran.detail, "fine step failed")) << fine_ran.detail;
-  mju_user_warning = previous;
   // A warning without the step's caveat does not excuse a disagreement.
   EXPECT_FALSE(WarnsStepDependence("starts stretched, far from equilibrium"));
 }
@@ -1867,8 +1864,7 @@ TEST(SceneFuzzOracle, AStretchedStartIsWarnedOnlyWhereItsUnstretchedTwinAgrees) 
 // failure. Where the stretch alone explains the run, the outcome is the stretch's: seed 644
 // rang too, but started unstretched it agrees, and no damped twin is judged.
 TEST(SceneFuzzOracle, TwoWarnedCausesAreWarnedOnlyWhereTheTwinWithoutBothAgrees) {
-  void (*previous)(const char*) = mju_user_warning;
-  mju_user_warning = CountWarning;
+  const testing::WarningHandler counting(CountWarning);
   const Scene s = Make(7637, kDraw);
   const mjtether::Run run = Simulate(s, kStep);
   EXPECT_TRUE(WarnsStepDependence(run.stretch_warning)) << run.stretch_warning;
@@ -1882,7 +1878,6 @@ TEST(SceneFuzzOracle, TwoWarnedCausesAreWarnedOnlyWhereTheTwinWithoutBothAgrees)
   const Outcome one_cause = Judge(Make(644, kDraw));
   EXPECT_EQ(one_cause.kind, kWarnedStretched) << one_cause.detail;
   EXPECT_FALSE(Contains(one_cause.detail, "with damping_ratio=1")) << one_cause.detail;
-  mju_user_warning = previous;
 }
 
 // The thrust-warned outcome (JudgeRuns, session 15) needs Attach's thrust warning and the same
@@ -1892,8 +1887,7 @@ TEST(SceneFuzzOracle, TwoWarnedCausesAreWarnedOnlyWhereTheTwinWithoutBothAgrees)
 // segments, thrust 1.85 x; 315 N against 421 N at 0.2 ms, and at 0.45 x still 30 N against
 // 44 N: the thrust is not the whole cause, a failure.
 TEST(SceneFuzzOracle, AThrustBeyondWhatTheTetherHoldsIsWarnedOnlyWhereItsThrottledTwinAgrees) {
-  void (*previous)(const char*) = mju_user_warning;
-  mju_user_warning = CountWarning;
+  const testing::WarningHandler counting(CountWarning);
   const Scene s = Make(9153, kDraw);
   const mjtether::Run run = Simulate(s, kStep);
   EXPECT_TRUE(WarnsThrustStepDependence(run.thrust_warning)) << run.thrust_warning;
@@ -1910,7 +1904,6 @@ TEST(SceneFuzzOracle, AThrustBeyondWhatTheTetherHoldsIsWarnedOnlyWhereItsThrottl
   EXPECT_FALSE(failed.pass) << failed.detail;
   EXPECT_EQ(failed.kind, "disagrees with 10x smaller step");
   EXPECT_TRUE(Contains(failed.detail, "x what it holds: disagrees")) << failed.detail;
-  mju_user_warning = previous;
   // A thrust warning without the step's caveat does not excuse a disagreement.
   EXPECT_FALSE(WarnsThrustStepDependence("the thrust: schedules push body 'rov' with 1 N"));
 }
@@ -1923,8 +1916,7 @@ TEST(SceneFuzzOracle, AThrustBeyondWhatTheTetherHoldsIsWarnedOnlyWhereItsThrottl
 // it still fails. (Until session 24 the first was world seed 459, which now agrees outright
 // from the chain-at-rest start.)
 TEST(SceneFuzzOracle, AStartInsideARockIsWarnedOnlyWhereItsClearTwinAgrees) {
-  void (*previous)(const char*) = mju_user_warning;
-  mju_user_warning = CountWarning;
+  const testing::WarningHandler counting(CountWarning);
   const Scene s = MakeWorld(116);
   ASSERT_LT(s.clearance, 0);
   const mjtether::Run run = Simulate(s, kStep);
@@ -1952,7 +1944,6 @@ TEST(SceneFuzzOracle, AStartInsideARockIsWarnedOnlyWhereItsClearTwinAgrees) {
   EXPECT_EQ(both.kind, kWarnedInsideRing);
   EXPECT_TRUE(Contains(both.detail, "geom moved clear, with damping_ratio=1: agrees"))
       << both.detail;
-  mju_user_warning = previous;
   EXPECT_FALSE(WarnsContactStepDependence("starts inside a geom it touches"));
 }
 
@@ -1971,8 +1962,7 @@ TEST(SceneFuzzOracle, AStartInsideARockIsWarnedOnlyWhereItsClearTwinAgrees) {
 // against 15.8 N at 0.2 ms and 16.4 N at 0.02 ms) is warned, and with damping_ratio=1 agrees
 // (15.71 against 15.76 N, as every implicit scheme reads it at 2 ms undamped).
 TEST(SceneFuzzOracle, AnUndampedRingingSnapIsWarnedOnlyWhereItsDampedTwinAgrees) {
-  void (*previous)(const char*) = mju_user_warning;
-  mju_user_warning = CountWarning;
+  const testing::WarningHandler counting(CountWarning);
   const Scene s = Make(5957, kDraw);
   const mjtether::Run run = Simulate(s, kStep);
   EXPECT_TRUE(Contains(run.ring_warning, "snapped taut")) << run.ring_warning;
@@ -2000,7 +1990,6 @@ TEST(SceneFuzzOracle, AnUndampedRingingSnapIsWarnedOnlyWhereItsDampedTwinAgrees)
   EXPECT_FALSE(failed.pass) << failed.detail;
   EXPECT_EQ(failed.kind, "disagrees with 10x smaller step");
   EXPECT_TRUE(Contains(failed.detail, "with damping_ratio=1: disagrees")) << failed.detail;
-  mju_user_warning = previous;
 }
 
 // Seed 6260 (implicit, 203 segments of 1.6 m, EA 1.1e5 N, undamped, a 19 kg vehicle on a slack
@@ -2012,8 +2001,7 @@ TEST(SceneFuzzOracle, AnUndampedRingingSnapIsWarnedOnlyWhereItsDampedTwinAgrees)
 // damping_ratio=1 it agrees (4.86 against 5.04 N). The jump in the warning is under 1 N, so the
 // relative criterion is the one that counted.
 TEST(SceneFuzzOracle, ASnapIsMeasuredAgainstTheSmallerEndTension) {
-  void (*previous)(const char*) = mju_user_warning;
-  mju_user_warning = CountWarning;
+  const testing::WarningHandler counting(CountWarning);
   const Scene s = Make(6260, kDraw);
   EXPECT_EQ(s.integrator, "implicit");
   const mjtether::Run run = Simulate(s, kStep);
@@ -2027,7 +2015,6 @@ TEST(SceneFuzzOracle, ASnapIsMeasuredAgainstTheSmallerEndTension) {
   EXPECT_TRUE(warned.pass) << warned.kind << ": " << warned.detail;
   EXPECT_EQ(warned.kind, kWarnedRing);
   EXPECT_TRUE(Contains(warned.detail, "with damping_ratio=1: agrees")) << warned.detail;
-  mju_user_warning = previous;
 }
 
 // PhaseRange on a made-up history at the coarse step: 5 N with one snap of 1005 N at the third
@@ -2068,8 +2055,7 @@ TEST(SceneFuzzOracle, TheWindowsRangeIsWhatASnapAtTheEdgeMovesTheMeanBy) {
 // was 3711, a snap train of a slack chain, and 539, whose snaps were shorter than the MuJoCo
 // step; the chain-at-rest start took the slack start, and with it those snaps, from both.)
 TEST(SceneFuzzOracle, ASnapTrainAgreesWithinAMovedWindowButAWrongImpulseDoesNot) {
-  void (*previous)(const char*) = mju_user_warning;
-  mju_user_warning = CountWarning;
+  const testing::WarningHandler counting(CountWarning);
   const Outcome phase = Judge(Make(1460, kDraw));
   EXPECT_TRUE(phase.pass) << phase.kind << ": " << phase.detail;
   EXPECT_EQ(phase.kind, kSnapPhase);
@@ -2077,7 +2063,6 @@ TEST(SceneFuzzOracle, ASnapTrainAgreesWithinAMovedWindowButAWrongImpulseDoesNot)
   EXPECT_FALSE(wrong.pass) << wrong.detail;
   EXPECT_EQ(wrong.kind, "disagrees with 10x smaller step");
   EXPECT_TRUE(Contains(wrong.detail, "windows up to a tenth earlier")) << wrong.detail;
-  mju_user_warning = previous;
 }
 
 
@@ -2094,8 +2079,7 @@ TEST(SceneFuzzOracle, ASnapTrainAgreesWithinAMovedWindowButAWrongImpulseDoesNot)
 // tolerance 0.22 J, as Energy.ExplicitSlackSwitchingGainsNoEnergyBeyondTheEndsWork asserts on
 // the engine alone.
 TEST(SceneFuzzOracle, EndWorkIsTheStepsForceAlongTheEndNodesDisplacement) {
-  void (*previous)(const char*) = mju_user_warning;
-  mju_user_warning = CountWarning;
+  const testing::WarningHandler counting(CountWarning);
   const Scene s = Make(9297, kDraw);
   ASSERT_TRUE(s.current.norm() == 0) << "the balance is checked without a current";
   const mjtether::Run coarse = Simulate(s, kStep);
@@ -2106,7 +2090,6 @@ TEST(SceneFuzzOracle, EndWorkIsTheStepsForceAlongTheEndNodesDisplacement) {
   EXPECT_LE(coarse.excess, EnergyTolerance(coarse));
   const Outcome o = Judge(s);
   EXPECT_TRUE(o.pass) << o.kind << ": " << o.detail;
-  mju_user_warning = previous;
 }
 
 // A coupling chatter stop below half the advisor's limit (session 27): accepted where Attach
@@ -2115,8 +2098,7 @@ TEST(SceneFuzzOracle, EndWorkIsTheStepsForceAlongTheEndNodesDisplacement) {
 // (explicit, 35 segments, a 19 kg vehicle, the held force at omega h 0.42) stops at 0.39 s with
 // the chatter named; at 0.2 ms it runs. The same scene with bdf2 gets no such warning nor stop.
 TEST(SceneFuzzOracle, AChatterStopBelowHalfTheLimitPassesWhereItWasWarnedAndTheStepCuresIt) {
-  void (*previous)(const char*) = mju_user_warning;
-  mju_user_warning = CountWarning;
+  const testing::WarningHandler counting(CountWarning);
   const Scene s = Make(10311, kDraw);
   const mjtether::Run coarse = Simulate(s, kStep);
   EXPECT_TRUE(coarse.held_warning);
@@ -2125,7 +2107,6 @@ TEST(SceneFuzzOracle, AChatterStopBelowHalfTheLimitPassesWhereItWasWarnedAndTheS
   EXPECT_TRUE(o.pass) << o.kind << ": " << o.detail;
   EXPECT_EQ(o.kind, "diverged: coupling chatter");
   EXPECT_TRUE(Contains(o.detail, "warned at load, and the 10x smaller step runs")) << o.detail;
-  mju_user_warning = previous;
 }
 
 }  // namespace

@@ -28,6 +28,7 @@
 
 #include "mjtether.h"
 #include "mjtether_vehicles.h"
+#include "warning_handler.h"
 
 namespace mjtether {
 namespace {
@@ -71,8 +72,7 @@ Outcome RunFrom(bool rk4, double speed, double force) {
   if (!m) return o;
   o.loaded = true;
   g_warnings = 0;
-  void (*previous)(const char*) = mju_user_warning;
-  mju_user_warning = CountWarning;
+  const testing::WarningHandler counting(CountWarning);
   mjData* d = mj_makeData(m);
   d->qvel[0] = speed;
   d->xfrc_applied[6 * 1 + 0] = force;  // body 1, the vehicle
@@ -87,7 +87,6 @@ Outcome RunFrom(bool rk4, double speed, double force) {
   }
   o.speed = d->qvel[0];
   o.warnings = g_warnings;
-  mju_user_warning = previous;
   mj_deleteData(d);
   Detach(m);
   mj_deleteModel(m);
