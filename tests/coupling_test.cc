@@ -424,6 +424,11 @@ TEST_F(Coupling, ChatterIsStoppedWithTetherBodyAndSetting) {
       << stopped;
   EXPECT_TRUE(Contains(stopped, "work balance does not explain it")) << stopped;
   EXPECT_TRUE(Contains(stopped, "Use integrator=bdf2 (the default) or implicit")) << stopped;
+  // Of the cure, what holds at every omega h (session 43; it said "the end node is solved with
+  // the body", which holds from omega h 1 only).
+  EXPECT_TRUE(Contains(stopped, "(no coupling limit, stable at every omega h measured; the end "
+                                "node is solved with the body from omega h 1)"))
+      << stopped;
   // The step advised is below the one that chattered (it was 2.5x above it: limit/omega).
   const double advised = AdvisedStep(stopped);
   EXPECT_GT(advised, 0) << stopped;
@@ -627,6 +632,16 @@ TEST_F(Coupling, HeldForceWhereItIsOftenOffIsWarnedAndBothCuresHold) {
   EXPECT_FALSE(WarnsHeldForce(fine));
   EXPECT_FALSE(WarnsHeldForce(bdf2));
   EXPECT_FALSE(WarnsHeldForce(cured));
+  // What the warning says of its cure is what the cure does (session 43; until then it said
+  // "the end node is solved with the body"): bdf2 has no coupling limit, and at omega h 0.25
+  // holds the end force as explicit does.
+  EXPECT_TRUE(Contains(held, "no coupling limit, so no chatter to grow; below omega h 1 they "
+                             "hold the end force too"))
+      << held;
+  const CouplingLimit b = GetCouplingLimit(bdf2, 0, 1);
+  EXPECT_EQ(b.limit, 0);
+  EXPECT_FALSE(b.consistent);
+  EXPECT_LT(b.omega_h, 1);
   ExpectEachAgreesWithTheFineRun(fine, {bdf2, cured});
 }
 
@@ -855,6 +870,12 @@ TEST_F(Coupling, ExplicitsConsistentCouplingAgreesAtSevenSubstepsAndIsWarnedBelo
   ASSERT_TRUE(fine && bdf2 && cured);
   EXPECT_EQ(LeadWarning(fine), "");  // the held force there (omega h 0.09)
   EXPECT_EQ(LeadWarning(bdf2), "");
+  // The cure as the warning describes it (session 43): bdf2 at omega h 0.92 has no limit and
+  // holds the end force (kLeadFrom 1).
+  EXPECT_TRUE(Contains(lead, "(no coupling limit; below omega h 1 they hold the end force"))
+      << lead;
+  EXPECT_FALSE(GetCouplingLimit(bdf2, 0, 1).consistent);
+  EXPECT_EQ(GetCouplingLimit(bdf2, 0, 1).limit, 0);
   EXPECT_EQ(LeadWarning(cured), "");
   ExpectEachAgreesWithTheFineRun(fine, {coarse, bdf2, cured});
   // The vehicle at 3 s (the growth took it 0.25 m off): within 5 cm of the 0.2 ms run's.
