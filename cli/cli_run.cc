@@ -122,6 +122,18 @@ int ReportCheck(const RunOptions& opt, const mjModel* m, double end_time,
   return kExitCheck;
 }
 
+// Whether a warning says that the run's outcome depends on its step and asks for the comparison
+// that --check-step makes.
+bool AsksForTheStepCheck(const std::string& warning) {
+  return warning.find("compare with a smaller") != std::string::npos ||
+         warning.find("10x smaller step") != std::string::npos;
+}
+
+void NoteTheStepCheck() {
+  std::cerr << "mjtether: note: --check-step 10 makes that comparison: it runs the scene also at "
+               "h/10 and says whether this run is off (docs/step_check.md)\n";
+}
+
 int Run(const RunOptions& opt) {
   using namespace mjtether::cli;
   using mjtether::CsvField;
@@ -136,13 +148,14 @@ int Run(const RunOptions& opt) {
   ModelPtr m = LoadChecked(opt.model, overrides);
   if (!m) return kExitBadInput;
   // A load warning that says the outcome depends on the step (a stretched start, a thrust near
-  // what the tether holds, a held end force) asks for a comparison that --check-step makes.
+  // what the tether holds, a held end force) asks for a comparison that --check-step makes; so
+  // does a run warning (a snap that rang, at the run's end), noted there unless noted here.
+  bool check_noted = false;
   if (opt.check_step == 0) {
     for (const std::string& w : mjtether::Warnings(m.get())) {
-      if (w.find("compare with a smaller one") != std::string::npos ||
-          w.find("10x smaller step") != std::string::npos) {
-        std::cerr << "mjtether: note: --check-step 10 makes that comparison: it runs the scene "
-                     "also at h/10 and says whether this run is off (docs/step_check.md)\n";
+      if (AsksForTheStepCheck(w)) {
+        NoteTheStepCheck();
+        check_noted = true;
         break;
       }
     }
@@ -339,6 +352,10 @@ int Run(const RunOptions& opt) {
   // Numerics; docs/reference.md "Internal damping").
   for (const std::string& w : mjtether::RunWarnings(mm, d)) {
     std::cerr << "mjtether: warning: " << w << "\n";
+    if (opt.check_step == 0 && !check_noted && AsksForTheStepCheck(w)) {
+      NoteTheStepCheck();
+      check_noted = true;
+    }
   }
   const bool rang = !mjtether::RingWarnings(mm, d).empty();  // for the step check's advice
   for (OutputFile* f : {&log, &nodes}) {

@@ -202,6 +202,71 @@ TEST(StepCheck, AStepDependentRunExitsSixAndKeepsItsLog) {
   for (size_t k = 0; k < c.rows.size(); ++k) EXPECT_EQ(kept.rows[k], c.rows[k]) << "row " << k;
 }
 
+// Mean of column `col` over the rows with t in [from, to) (the check's window; column 0 is time).
+double WindowMean(const Log& log, int col, double from, double to) {
+  double sum = 0;
+  int n = 0;
+  for (const std::vector<double>& row : log.rows) {
+    if (row[0] >= from - 1e-9 && row[0] < to - 1e-9) sum += row[col], ++n;
+  }
+  return n ? sum / n : NAN;
+}
+
+// A run warning that asks for the comparison (a snap that rang the undamped segment mode, at the
+// run's end) is followed by the note that points to --check-step, once; a checked run has none.
+// The scene is a line started as long as its span (scene fuzzer seed 491 at
+// MJTETHER_SCENE_FUZZ_SLACK=0): it has no load warning, so the note can only come from the run's.
+TEST(StepCheck, ARunWarningThatAsksForTheComparisonPointsToTheCheck) {
+  const std::string model = kDir + "/near_taut_start.xml";
+  const Output plain = Cli("run " + model + " --duration 1");
+  ASSERT_EQ(plain.status, 0) << plain.text;
+  const size_t warned = plain.text.find("a slack segment snapped taut at t = ");
+  ASSERT_NE(warned, std::string::npos) << plain.text;
+  const size_t asks = plain.text.find("compare with a smaller <option timestep>", warned);
+  EXPECT_NE(asks, std::string::npos) << plain.text;
+  const std::string note = "note: --check-step 10 makes that comparison";
+  const size_t noted = plain.text.find(note);
+  ASSERT_NE(noted, std::string::npos) << plain.text;
+  EXPECT_GT(noted, warned) << "the note follows the run's warning\n" << plain.text;
+  EXPECT_EQ(plain.text.find(note, noted + 1), std::string::npos) << "once\n" << plain.text;
+  const Output checked = Cli("run " + model + " --duration 1 --check-step 10");
+  EXPECT_EQ(checked.text.find(note), std::string::npos) << checked.text;
+}
+
+// What the ringing warning now says of a line started near taut, measured: with damping_ratio=1
+// (the warning's cure for the segment mode, which then is not watched) the vehicle-end tension
+// over 0.8-1 s still differs between 2 ms and 0.2 ms by more than the fuzzer's tolerance
+// (10.7 against 23.3 N), while 0.5 ms agrees with 0.2 ms (23.2 N; 23.3 N at 0.02 ms): a smaller
+// step, which the warning asks to compare with, is the cure. --check-step 10 finds it (exit 6).
+// If a change makes 2 ms agree, the warning's sentence "damped or not the tensions after it
+// depend on the step" is no longer true of this scene: revise it.
+TEST(StepCheck, ALineStartedNearTautDependsOnTheStepDampedOrNot) {
+  const std::string dir = TempDir();
+  const std::string model = kDir + "/near_taut_start.xml";
+  const std::string damped = " --set tether:t.damping_ratio=1 --duration 1 --every 0.002";
+  double mean[3];
+  const char* steps[3] = {"0.002", "0.0005", "0.0002"};
+  for (int k = 0; k < 3; ++k) {
+    const std::string log = dir + "/h" + steps[k] + ".csv";
+    const Output run =
+        Cli("run " + model + damped + " --set option.timestep=" + steps[k] + " --log " + log);
+    ASSERT_EQ(run.status, 0) << run.text;
+    EXPECT_EQ(run.text.find("snapped taut"), std::string::npos) << "damped: not watched";
+    const Log l = ReadLog(log);
+    const int col = l.Column("t.tension_B");
+    ASSERT_GE(col, 0);
+    mean[k] = WindowMean(l, col, 1 - kWindow, 1 + 1e-9);
+    ASSERT_TRUE(std::isfinite(mean[k])) << steps[k];
+  }
+  EXPECT_GT(std::abs(mean[0] - mean[2]), TensionTolerance(mean[0], mean[2]))
+      << mean[0] << " N at 2 ms, " << mean[2] << " N at 0.2 ms";
+  EXPECT_LE(std::abs(mean[1] - mean[2]), TensionTolerance(mean[1], mean[2]))
+      << mean[1] << " N at 0.5 ms, " << mean[2] << " N at 0.2 ms";
+  const Output check = Cli("run " + model + damped + " --check-step 10");
+  EXPECT_EQ(check.status, 6) << check.text;
+  EXPECT_NE(check.text.find("DISAGREES"), std::string::npos) << check.text;
+}
+
 // A run that stops: the check says whether the smaller step cures it, and is right both ways
 // (the same scene run alone at h/10 exits 0, or stops too).
 TEST(StepCheck, AStopIsBlamedOnTheStepOnlyWhenTheSmallerStepRuns) {
