@@ -205,6 +205,7 @@ struct ModelTethers {
   std::vector<std::string> warnings;  // time-step advisor (see Warnings in mjtether.h)
   Environment env;                    // gravity and water, for the divergence diagnosis
   int nv = 0;                         // m->nv: the coupling's Jacobian scratch is 6 nv doubles
+  double timestep = 0;  // [s] m->opt.timestep at Attach, for which the coupling was chosen
 };
 
 // Coupling chatter (docs/coupling.md): the energy an end gave its body beyond what the tether
@@ -2684,6 +2685,7 @@ bool Attach(mjModel* m, const std::string& source, std::string* error) {
     return false;
   }
   set->nv = m->nv;
+  set->timestep = m->opt.timestep;
   m->nuserdata = offset;
   m->nstack += set->work_size + 6 * std::max(m->nv, 1) + 64;
   set->nuserdata = m->nuserdata;
@@ -2932,6 +2934,32 @@ std::vector<std::string> StallWarnings(const mjModel* m, const mjData* d, bool e
       << StallAdvice(m, t);
     out.push_back(s.str());
   }
+  return out;
+}
+
+std::vector<std::string> StepWarnings(const mjModel* m) {
+  std::vector<std::string> out;
+  const ModelTethers* set = Lookup(m);
+  if (!set || m->opt.timestep == set->timestep) return out;
+  std::ostringstream s;
+  s << set->source << ": <option timestep> is " << m->opt.timestep << " s, not the "
+    << set->timestep << " s the tethers were attached with: the coupling at each end on a body "
+    << "that moves was chosen, and the advisor's limits, refusals and warnings were computed, "
+    << "for " << set->timestep << " s";
+  for (const AttachedTether& at : set->tethers) {
+    for (int end = 0; end < 2; ++end) {
+      const CouplingLimit& c = at.limit[end];
+      if (at.site[end] < 0 || !at.coupled[end] || !(c.omega > 0)) continue;
+      s << "; tether '" << at.name << "' end " << "AB"[end] << ": "
+        << (c.consistent ? "consistent coupling" : "held end force") << " at coupling omega h "
+        << c.omega * set->timestep << ", now " << c.omega * m->opt.timestep;
+    }
+  }
+  s << ". Load the model at the step it runs at (<option timestep> in the MJCF, or LoadModel "
+       "with the override option.timestep; the command line's --set option.timestep does so): "
+       "a changed step is checked only by the run-time stops (chatter, divergence), and the "
+       "results may differ from the same scene loaded at that step (docs/coupling.md)";
+  out.push_back(s.str());
   return out;
 }
 

@@ -101,6 +101,74 @@ using Coupling = testing::MuJoCoFixture;
 // orientation): W = I/(m + a) + [r]x^T diag(1/(J_i + A_i)) [r]x, m = 11.5 kg, a = 5.5 kg (the
 // isotropic added mass in the armature), J = 0.16 kg m^2, A = 0.12 kg m^2, r = (-0.229, 0,
 // 0.1) m; omega = sqrt(k_end/m_eff); omega h at 2 ms. Rounding only: 1e-9.
+// The scene fuzzer's seed 491 with its tether as long as its span and damping_ratio=1
+// (tests/step_check/near_taut_start.xml): 65 segments of implicit2 on an 11 kg vehicle, coupling
+// omega 919 rad/s, so the consistent coupling at 2 ms (omega h 1.84) and the held end force at
+// 0.5 ms (0.46, below kLeadFromImplicit2).
+std::string NearTautXml(const char* timestep) {
+  return std::string("<mujoco><option timestep=\"") + timestep + "\"/><custom>"
+      "<text name=\"water\" data=\"density=1025 current=0.7674784569,0.2768948667,0\"/>"
+      "<text name=\"vehicle:rov\" data=\"volume=0.01097654479 cob=0,0,0.02229919655 "
+      "added_mass=6.466188298,6.140304403,6.741719731,0.02756868696,0.02756868696,0.02756868696 "
+      "linear_damping=7.224561053,7.224561053,7.224561053,0.09189562318,0.09189562318,"
+      "0.09189562318 quadratic_damping=25.48427605,25.48427605,25.48427605,0.09189562318,"
+      "0.09189562318,0.09189562318 coriolis=0\"/>"
+      "<text name=\"tether:t\" data=\"ends=tms_site,att length=14.11708783 segments=65 "
+      "diameter=0.0275621761 mass_per_length=1.389232123 EA=3161725.236 Cdn=1.2 Cdt=0.01 Can=1 "
+      "integrator=implicit2 EI=39.26523929 EAc=3161725.236 damping_ratio=1\"/>"
+      "</custom><worldbody><body name=\"tms\" mocap=\"true\"><site name=\"tms_site\"/></body>"
+      "<body name=\"rov\" pos=\"-7.58807253 10.63613762 -5.346578393\"><freejoint/>"
+      "<inertial pos=\"0 0 0\" mass=\"11.0883684\" diaginertia=\"0.09189562318 0.09189562318 "
+      "0.09189562318\"/><site name=\"att\"/><site name=\"thr\"/></body></worldbody></mujoco>";
+}
+
+// The mean vehicle-end tension over the last 0.2 s of 1 s (each step's, as GetReactions reads it).
+double LateMeanTension(mjModel* m, mjData* d) {
+  double sum = 0;
+  int n = 0;
+  while (d->time < 1 - 1e-9) {
+    mj_step(m, d);
+    if (d->time > 0.8 + 1e-9) sum += GetReactions(m, d, 0).tension_b, ++n;
+  }
+  return sum / n;
+}
+
+// A step changed after loading (m->opt.timestep set by the user's code) keeps the coupling
+// chosen for the step at load, and the result is not the scene's at the new step: loaded at
+// 2 ms and run at 0.5 ms the consistent coupling stays and reads 17.4 N, against 23.2 N loaded at
+// 0.5 ms (the command line's 0.2 and 0.02 ms: 23.27 and 23.30 N). RunWarnings says so, naming
+// both steps and the coupling with its omega h at each; the model loaded at its step has no such
+// warning. Before session 44 nothing was said.
+TEST_F(Coupling, AStepChangedAfterLoadingIsWarnedWithTheCouplingItKept) {
+  mjModel* changed = Load(NearTautXml("0.002"), "near_taut.xml");
+  mjModel* loaded = Load(NearTautXml("0.0005"), "near_taut.xml");
+  ASSERT_TRUE(changed && loaded);
+  EXPECT_TRUE(StepWarnings(changed).empty());
+  changed->opt.timestep = 0.0005;
+  ASSERT_TRUE(GetCouplingLimit(changed, 0, 1).consistent);
+  ASSERT_FALSE(GetCouplingLimit(loaded, 0, 1).consistent);
+  mjData* dc = Make(changed);
+  mjData* dl = Make(loaded);
+  const double t_changed = LateMeanTension(changed, dc), t_loaded = LateMeanTension(loaded, dl);
+  ASSERT_FALSE(CheckDivergence(changed, dc));
+  ASSERT_FALSE(CheckDivergence(loaded, dl));
+  EXPECT_GT(std::abs(t_changed - t_loaded), 0.05 * t_loaded)
+      << t_changed << " N loaded at 2 ms, " << t_loaded << " N loaded at 0.5 ms: if they agree, "
+      << "the warning's claim that results may differ needs another example";
+  EXPECT_TRUE(StepWarnings(loaded).empty());
+  const std::vector<std::string> w = RunWarnings(changed, dc);
+  ASSERT_FALSE(w.empty());
+  EXPECT_NE(w[0].find("near_taut.xml: <option timestep> is 0.0005 s, not the 0.002 s the tethers "
+                      "were attached with"), std::string::npos) << w[0];
+  EXPECT_NE(w[0].find("tether 't' end B: consistent coupling at coupling omega h 1.838"),
+            std::string::npos) << w[0];
+  EXPECT_NE(w[0].find(", now 0.4596"), std::string::npos) << w[0];
+  EXPECT_NE(w[0].find("LoadModel with the override option.timestep"), std::string::npos) << w[0];
+  // Set back, the warning goes.
+  changed->opt.timestep = 0.002;
+  EXPECT_TRUE(StepWarnings(changed).empty());
+}
+
 TEST_F(Coupling, LimitMatchesItsFormula) {
   mjModel* m = Load(BlueRovXml("1e6", "explicit", 0.002));
   ASSERT_NE(m, nullptr);
