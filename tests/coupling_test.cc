@@ -96,30 +96,18 @@ INSTANTIATE_TEST_SUITE_P(BlueRov2, CouplingCases,
 
 using Coupling = testing::MuJoCoFixture;
 
-// The advisor's figures against their formula: k_end = EA/L0; m_eff = 1/lambda_max(W), with
-// W = J M^-1 J^T of a free body at a site r from its centre of mass (body at rest, identity
-// orientation): W = I/(m + a) + [r]x^T diag(1/(J_i + A_i)) [r]x, m = 11.5 kg, a = 5.5 kg (the
-// isotropic added mass in the armature), J = 0.16 kg m^2, A = 0.12 kg m^2, r = (-0.229, 0,
-// 0.1) m; omega = sqrt(k_end/m_eff); omega h at 2 ms. Rounding only: 1e-9.
 // The scene fuzzer's seed 491 with its tether as long as its span and damping_ratio=1
 // (tests/step_check/near_taut_start.xml): 65 segments of implicit2 on an 11 kg vehicle, coupling
 // omega 919 rad/s, so the consistent coupling at 2 ms (omega h 1.84) and the held end force at
 // 0.5 ms (0.46, below kLeadFromImplicit2).
 std::string NearTautXml(const char* timestep) {
-  return std::string("<mujoco><option timestep=\"") + timestep + "\"/><custom>"
-      "<text name=\"water\" data=\"density=1025 current=0.7674784569,0.2768948667,0\"/>"
-      "<text name=\"vehicle:rov\" data=\"volume=0.01097654479 cob=0,0,0.02229919655 "
-      "added_mass=6.466188298,6.140304403,6.741719731,0.02756868696,0.02756868696,0.02756868696 "
-      "linear_damping=7.224561053,7.224561053,7.224561053,0.09189562318,0.09189562318,"
-      "0.09189562318 quadratic_damping=25.48427605,25.48427605,25.48427605,0.09189562318,"
-      "0.09189562318,0.09189562318 coriolis=0\"/>"
-      "<text name=\"tether:t\" data=\"ends=tms_site,att length=14.11708783 segments=65 "
-      "diameter=0.0275621761 mass_per_length=1.389232123 EA=3161725.236 Cdn=1.2 Cdt=0.01 Can=1 "
-      "integrator=implicit2 EI=39.26523929 EAc=3161725.236 damping_ratio=1\"/>"
-      "</custom><worldbody><body name=\"tms\" mocap=\"true\"><site name=\"tms_site\"/></body>"
-      "<body name=\"rov\" pos=\"-7.58807253 10.63613762 -5.346578393\"><freejoint/>"
-      "<inertial pos=\"0 0 0\" mass=\"11.0883684\" diaginertia=\"0.09189562318 0.09189562318 "
-      "0.09189562318\"/><site name=\"att\"/><site name=\"thr\"/></body></worldbody></mujoco>";
+  std::ifstream f(std::string(MJTETHER_STEP_CHECK_DIR) + "/near_taut_start.xml");
+  std::stringstream xml;
+  xml << f.rdbuf();
+  EXPECT_FALSE(xml.str().empty()) << "tests/step_check/near_taut_start.xml";
+  return Replace(Replace(xml.str(), "timestep=\"0.002\"",
+                         std::string("timestep=\"") + timestep + "\""),
+                 "integrator=implicit2", "damping_ratio=1 integrator=implicit2");
 }
 
 // The mean vehicle-end tension over the last 0.2 s of 1 s (each step's, as GetReactions reads it).
@@ -169,6 +157,11 @@ TEST_F(Coupling, AStepChangedAfterLoadingIsWarnedWithTheCouplingItKept) {
   EXPECT_TRUE(StepWarnings(changed).empty());
 }
 
+// The advisor's figures against their formula: k_end = EA/L0; m_eff = 1/lambda_max(W), with
+// W = J M^-1 J^T of a free body at a site r from its centre of mass (body at rest, identity
+// orientation): W = I/(m + a) + [r]x^T diag(1/(J_i + A_i)) [r]x, m = 11.5 kg, a = 5.5 kg (the
+// isotropic added mass in the armature), J = 0.16 kg m^2, A = 0.12 kg m^2, r = (-0.229, 0,
+// 0.1) m; omega = sqrt(k_end/m_eff); omega h at 2 ms. Rounding only: 1e-9.
 TEST_F(Coupling, LimitMatchesItsFormula) {
   mjModel* m = Load(BlueRovXml("1e6", "explicit", 0.002));
   ASSERT_NE(m, nullptr);
