@@ -527,7 +527,7 @@ void StartWinchShape(const AttachedTether& at, const Tether& tether, double* u, 
 // 32's long runs this watch turned 21 of the 30 explicit and rk4 failures into runs that warned and
 // whose damped twin agrees, and no pass into a failure (docs/reference.md, "Internal damping").
 // The warning's cure does not reach a line started near taut (session 44): the scene fuzzer's
-// seeds 201-2200 with every tether as long as its span failed 13 of 1,049 runs, 10 of them
+// seeds 201-2200 with every tether as long as its span failed 13 of 1,066 runs, 10 of them
 // warned here, none of the 10 agreeing with damping_ratio=1. Most of the line goes slack and
 // snaps taut, the slower modes take the snap, and the tensions after it depend on the step
 // damped or not: seed 491 at the span (implicit2, 65 segments, 14.1 m), damped, reads 10.7,
