@@ -214,7 +214,9 @@ std::vector<std::string> StallWarnings(const mjModel* m, const mjData* d, bool e
 // with an energy that depends on the step: their tensions after the snap depend on the step and
 // on the segment count (docs/reference.md, "Internal damping"). One message per such tether,
 // with the first snap's time, the largest jump and damping_ratio=1 as the cure; empty otherwise.
-// The CLI prints them at the end of a run.
+// Where the segment mode is not watched, the snaps of a tether whose end body's bounce on the
+// taut line is (BounceMode::watched, below) give a message naming that bounce, with a smaller
+// <option timestep> as the cure (session 45). The CLI prints them at the end of a run.
 std::vector<std::string> RingWarnings(const mjModel* m, const mjData* d);
 // A warning where m->opt.timestep is not the step the model was attached with (changed after
 // LoadModel or Attach): the coupling of each end on a body that moves, the time-step advisor's
@@ -245,6 +247,34 @@ inline constexpr double kRingOmegaH = 0.05;
 // kRingDampingRatio and its omega_n h above kRingOmegaH (h: the tether's own step, an explicit
 // substep), and no winch (its segments change).
 bool WatchesRinging(const Tether& t, double timestep);
+// The body at a tether's end bouncing on the whole taut line: the line as one spring K = EA/L
+// on the body's smallest effective mass at the site (CouplingLimit::m_eff), damped by the line's
+// internal damping, damping/L. Its damping ratio is the segment mode's times sqrt(m_line/m_eff)/2
+// or so: a line whose segment mode is damped (damping ratio above kRingDampingRatio, not watched
+// by WatchesRinging) still leaves its vehicle's bounce nearly undamped, and a snap at the vehicle
+// rings that bounce, which the step damps numerically (an implicit step, by about kappa omega h /
+// 2 per radian) or resolves (a 10x smaller one). 2 of the scene fuzzer's 3 long-run failures
+// that exited 0 with no warning before session 45
+// were such scenes: 9508 (implicit2, damping ratio of the segment mode 2.1, of the bounce 0.0014,
+// omega h 2.3) and 10280 (implicit, 0.38 and 0.0002, 0.86: the vehicle-end tension over 0.8-1 s
+// is 1490 N at 2 ms, 1811 N at 0.2 ms, 1892 N at 0.02 ms, with damping_ratio=1 1663, 1802 and
+// 1888 N; tests/step_check/vehicle_bounce.xml, docs/reference.md "Internal damping"). The third,
+// 5069 (bdf2, 0.14 and 0.0012, 0.60), bounces too, but its 3 segments stay shorter than their
+// rest length throughout (EAc = EA: a rod in compression, heaved at its top): no snap to watch,
+// and it stays silent.
+struct BounceMode {
+  double omega = 0;      // [rad/s] sqrt(EA/(L m_eff))
+  double omega_h = 0;    // [-] omega times <option timestep> at Attach
+  double ratio = 0;      // [-] damping ratio, (damping/L)/(2 m_eff omega); 0 without damping
+  bool watched = false;  // snaps watched for it (RingWarnings), below
+};
+// Tether k's end `end` (0: A, 1: B) on a body with degrees of freedom; omega 0 otherwise.
+BounceMode GetBounceMode(const mjModel* m, int k, int end);
+// [-] A snap is watched for the bounce where the segment mode is not watched (WatchesRinging),
+// the bounce's damping ratio is below kRingDampingRatio and its omega h at or above this (no
+// winch): below it the consistent coupling's slow-mode correction (docs/coupling.md, session 34,
+// omega h <= 0.1) takes the step's numerical damping off a taut line's bounce.
+inline constexpr double kBounceOmegaH = 0.1;
 
 // Replaces MuJoCo's default error handler (which waits on stdin) by one that prints the
 // message and exits with status 3, and routes warnings to stderr. Idempotent.

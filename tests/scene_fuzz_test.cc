@@ -711,6 +711,9 @@ struct Run {
   bool held_warning = false;    // Attach warned of a held end force at omega h >= 0.1
   bool lead_warning = false;    // ... or of explicit's consistent coupling at omega h 0.1-1
   std::string ring_warning;     // RingWarnings at the end: a snap rang the undamped segment mode
+  // RingWarnings' other message (session 45): a snap rang the vehicle's bounce on the taut line
+  // (BounceMode), whose cure is the step, not damping_ratio=1: counted, judged by no twin.
+  std::string bounce_warning;
   double duration = kDuration;  // [s] simulated
   double deployed = 0;  // [m] a winch's deployed unstretched length at the end (0: no winch)
   // Energy balance of the tether (scenes without current, see EnergyExcess): the largest
@@ -869,7 +872,8 @@ Run Simulate(const Scene& s, double step, double duration = -1) {
   if (t_warnings > 0) run.message = t_last_warning;
   run.stalled = static_cast<int>(StallWarnings(m, d).size());
   if (const std::vector<std::string> ring = RingWarnings(m, d); !ring.empty()) {
-    run.ring_warning = ring.front();
+    (Contains(ring.front(), "bouncing on the taut line") ? run.bounce_warning : run.ring_warning) =
+        ring.front();
   }
   run.tension = count > 0 ? sum / count : 0;
   const int rov = mj_name2id(m, mjOBJ_BODY, "rov"), tms = mj_name2id(m, mjOBJ_BODY, "tms");
@@ -903,6 +907,7 @@ struct Outcome {
   // The 2 ms run warned at its end that a snap rang the undamped segment mode (RingWarnings):
   // counted, and judged by the damped twin only where the run disagrees.
   bool rang = false;
+  bool bounced = false;  // ... that a snap rang the vehicle's bounce (Run::bounce_warning)
 };
 
 // The omega h at which the advisor refuses the scene's integrator (0: no limit).
@@ -1386,6 +1391,7 @@ thread_local bool t_shortened = false;
 thread_local bool t_stalled = false;
 thread_local bool t_held = false;
 thread_local bool t_rang = false;
+thread_local bool t_bounced = false;
 
 // The twin of a warned run (the scene with the warned cause taken away: Cleared, Damped),
 // judged like any scene at 2 ms for `duration`: it agrees where it passes and its own run gives
@@ -1430,6 +1436,7 @@ Outcome JudgeRuns(const Scene& s) {
   t_stalled = coarse.stalled > 0;
   t_held = coarse.held_warning;
   t_rang = !coarse.ring_warning.empty();
+  t_bounced = !coarse.bounce_warning.empty();
   if (!coarse.loaded) return CheckRefusal(s, coarse.error);
   if (const std::string expected = ExpectedRefusal(s); !expected.empty()) {
     return {"not refused", false, "expected a refusal: " + expected};
@@ -1671,12 +1678,13 @@ Outcome JudgeRuns(const Scene& s) {
 }
 
 Outcome Judge(const Scene& s) {
-  t_shortened = t_stalled = t_held = t_rang = false;
+  t_shortened = t_stalled = t_held = t_rang = t_bounced = false;
   Outcome o = JudgeRuns(s);
   o.shortened = t_shortened;
   o.stalled = t_stalled;
   o.held = t_held;
   o.rang = t_rang;
+  o.bounced = t_bounced;
   return o;
 }
 
@@ -1745,7 +1753,8 @@ void RunScenes(const std::vector<SceneId>& list, const std::set<SceneId>& known,
            << ", seabed kind " << s.seabed_kind << ", thrust/holds=" << s.thrust / s.holds()
            << Describe(s) << "]: " << (o.pass ? "pass" : "FAIL") << ": " << o.kind << ": "
            << o.detail << (o.held ? " [warned at load: held end force]" : "")
-           << (o.rang ? " [warned at run: a snap rang the segment mode]" : "");
+           << (o.rang ? " [warned at run: a snap rang the segment mode]" : "")
+           << (o.bounced ? " [warned at run: a snap rang the vehicle's bounce]" : "");
       std::lock_guard<std::mutex> lock(mutex);
       ++counts[(o.pass ? "pass  " : "FAIL  ") + o.kind];
       if (o.shortened) ++counts["(of these, run shortened below 1 s by the cost budget)"];
@@ -1757,6 +1766,10 @@ void RunScenes(const std::vector<SceneId>& list, const std::set<SceneId>& known,
       if (o.rang) {
         ++counts[o.pass ? "(of these, passes warned of a snap ringing the segment mode)"
                         : "(of these, failures warned of a snap ringing the segment mode)"];
+      }
+      if (o.bounced) {
+        ++counts[o.pass ? "(of these, passes warned of a snap ringing the vehicle's bounce)"
+                        : "(of these, failures warned of a snap ringing the vehicle's bounce)"];
       }
       const bool is_known = known.count(list[i]) > 0;
       if (!o.pass && is_known) known_failures.push_back(line.str());
