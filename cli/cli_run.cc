@@ -518,11 +518,12 @@ int Info(const std::string& path, const std::vector<std::string>& set) {
       std::cout << "\n";
       // The body bouncing on the whole taut line (BounceMode, RingWarnings' bounce watch).
       const mjtether::BounceMode b = mjtether::GetBounceMode(m, k, end);
-      std::cout << "      body bounce on the taut line: omega = sqrt(EA/(L m_eff)) = " << b.omega
+      std::cout << "      body bounce on the taut line: omega = sqrt(EA/(L (m_eff + mu L/3))) = "
+                << b.omega
                 << " rad/s, omega h = " << b.omega_h << ", damping ratio " << b.ratio
-                << (b.watched ? " (snaps watched: the step damps or keeps a bounce whose "
-                                "tensions then depend on it)"
-                              : "")
+                << (b.watched         ? " (snaps and swings watched)"
+                    : b.swing_watched ? " (swings watched)"
+                                      : "")
                 << "\n";
     }
   }

@@ -52,6 +52,13 @@ enum Slot : int {
   kStallRun,                        // consecutive advances with a stalled step (kStallStop)
   kSnapTime,                        // [s] d->time of the first ringing snap (WatchSnaps)
   kSnapJump,                        // [N] the largest such snap's wave tension jump (0: none)
+  kSwingStart,  // [s] WatchSwing: d->time at the start of the current block of two bounce periods
+  kSwingMin,    // [N] the end tension's smallest in that block
+  kSwingMax,    // [N] ... its largest
+  kSwingSum,    // [N] ... its sum
+  kSwingCount,  // [-] ... the steps in it (0: no block yet)
+  kSwingBest,   // [-] the largest (max - min)/mean of a closed block
+  kSwingTime,   // [s] the start of that block
   kHeldMeanA,  // [N] (3) implicit2: end A's held force (HeldMean) minus the force at the
                // state of the last advance, so that calls between advances give the same
   kHeldMeanB = kHeldMeanA + 3,      // [N] (3) the same for end B where it is held
@@ -121,6 +128,7 @@ struct AttachedTether {
   // for snaps where the segment mode is not (WatchSnaps, RingWarnings' second message).
   BounceMode bounce[2];
   int bounce_end = -1;  // the end whose bounce WatchSnaps watches (-1: none)
+  int swing_end = -1;   // the end whose bounce WatchSwing watches (-1: none)
   // The end's node on the seabed would be stiff on its body's step (max(omega_s h, h c_s/m_eff)
   // >= kLeadFromSeabed) and the end has the held force: CheckSeabedEnd stops the tether when the
   // node touches the seabed. seabed_cure: the consistent coupling would have been taken with
@@ -553,9 +561,36 @@ bool WatchesRinging(const Tether& t, double timestep) {
 }
 
 namespace {
+// The swing of a body's bounce on the taut line (BounceMode::swing_watched, session 45): the
+// end tension over blocks of two bounce periods, its peak-to-peak against its mean. Called before
+// each advance, with the last advance's tension (none before the first: time at the start).
+void WatchSwing(const AttachedTether& at, double time, double* u) {
+  if (at.swing_end < 0 || !(time > u[kStartTime])) return;
+  const double T = u[at.swing_end == 0 ? kTensionA : kTensionB];  // [N]
+  const double block = 2 * 2 * M_PI / at.bounce[at.swing_end].omega;  // [s]
+  if (u[kSwingCount] > 0 && time - u[kSwingStart] < block) {
+    u[kSwingMin] = std::min(u[kSwingMin], T);
+    u[kSwingMax] = std::max(u[kSwingMax], T);
+    u[kSwingSum] += T;
+    u[kSwingCount] += 1;
+    return;
+  }
+  if (u[kSwingCount] > 0) {
+    const double mean = u[kSwingSum] / u[kSwingCount], swing = u[kSwingMax] - u[kSwingMin];
+    if (mean > 0 && swing >= kRingJump && swing / mean > u[kSwingBest]) {
+      u[kSwingBest] = swing / mean;
+      u[kSwingTime] = u[kSwingStart];
+    }
+  }
+  u[kSwingStart] = time;
+  u[kSwingMin] = u[kSwingMax] = u[kSwingSum] = T;
+  u[kSwingCount] = 1;
+}
+
 void WatchSnaps(const AttachedTether& at, const double* x, const double* v, double dt,
                 double time, double* u) {
   const Tether& t = at.tether;
+  WatchSwing(at, time, u);
   if (at.bounce_end < 0 && !WatchesRinging(t, dt)) return;
   const double jump = t.SnapJump(x, v, dt);
   // A snap of kRingBigJump counts; a smaller one where it is kRingRelative of the smaller of
@@ -2271,17 +2306,26 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
       c.m_eff = 1 / lambda;
       c.omega = std::sqrt(c.k_end * lambda);
       c.omega_h = c.omega * h;
-      // The body bouncing on the whole taut line (BounceMode): a spring EA/L on m_eff, damped by
-      // the line's internal damping, damping/L (EndDamping() is damping/L0; 0 without it).
+      // The body bouncing on the whole taut line (BounceMode): a spring EA/L on m_eff and a
+      // third of the line's mass (Rayleigh's spring mass; seed 1920's single 125 m segment has
+      // a 42 kg end node on a 20 kg m_eff), damped by the line's internal damping, damping/L
+      // (EndDamping() is damping/L0; 0 without it).
       BounceMode& bounce = at.bounce[end];
-      bounce.omega = std::sqrt(p.EA / p.length * lambda);
+      bounce.mass = c.m_eff + p.mass_per_length * p.length / 3;
+      bounce.omega = std::sqrt(p.EA / p.length / bounce.mass);
       bounce.omega_h = bounce.omega * h;
-      bounce.ratio = t.EndDamping() / t.segments() / (2 * c.m_eff * bounce.omega);
+      bounce.ratio = t.EndDamping() / t.segments() / (2 * bounce.mass * bounce.omega);
       bounce.watched = !at.winch && !WatchesRinging(t, h) && bounce.ratio < kRingDampingRatio &&
                        bounce.omega_h >= kBounceOmegaH;
       if (bounce.watched &&
           (at.bounce_end < 0 || bounce.omega_h > at.bounce[at.bounce_end].omega_h)) {
         at.bounce_end = end;
+      }
+      bounce.swing_watched = !at.winch && bounce.ratio < kRingDampingRatio &&
+                             bounce.omega_h >= kBounceOmegaH;
+      if (bounce.swing_watched &&
+          (at.swing_end < 0 || bounce.omega_h > at.bounce[at.swing_end].omega_h)) {
+        at.swing_end = end;
       }
       c.limit = p.integrator == Integrator::kRK4        ? kCouplingLimitRk4
                 : p.integrator == Integrator::kExplicit  ? kCouplingLimitExplicit
@@ -2993,9 +3037,35 @@ std::vector<std::string> RingWarnings(const mjModel* m, const mjData* d) {
   if (!set) return out;
   for (const AttachedTether& at : set->tethers) {
     const double* u = d->userdata + at.offset;
-    if (!(u[kSnapJump] > 0)) continue;
     const Tether& t = at.tether;
     std::ostringstream s;
+    if (!(u[kSnapJump] > 0) && at.swing_end >= 0 && u[kSwingBest] >= kSwingRatio) {
+      // The swing watch (WatchSwing): a bounce that did not snap, or whose snaps were not watched.
+      const BounceMode& b = at.bounce[at.swing_end];
+      const CouplingLimit& c = at.limit[at.swing_end];
+      const char* body = mj_id2name(m, mjOBJ_BODY, c.body);
+      s << set->source << ": tether '" << at.name << "': the tension at end "
+        << "AB"[at.swing_end] << " swung by " << u[kSwingBest]
+        << " times its mean within two periods of body '" << (body ? body : "?")
+        << "' bouncing on the taut line (from t = " << u[kSwingTime]
+        << " s; the line a spring EA/L on the body's effective mass " << c.m_eff
+        << " kg and a third of the line's, " << b.mass << " kg: omega = " << b.omega << " rad/s, omega h = " << b.omega_h
+        << " at <option timestep> " << set->timestep << " s, damping ratio " << b.ratio
+        << "): the step "
+        << (IsExplicit(t.params().integrator) ? "keeps that bounce with an energy error"
+            : b.omega_h > 1                   ? "does not resolve that bounce and damps it"
+                                              : "damps that bounce numerically")
+        << ", and a swing that large moves the mean tension (quadratic drag, the line's "
+           "geometry, slack), so the tensions may depend on the step (a 12 kg vehicle on one "
+           "taut segment, bounce omega h 0.16: 3.5 N at 2 ms, 21.7 N at 0.2 ms, 32.7 N at "
+           "0.02 ms; of the scene fuzzer's runs so warned with lines started as long as their "
+           "span, 3 in 130 were off their 10x smaller step): compare with a smaller <option "
+           "timestep> (the bounce's period is "
+        << 2 * M_PI / b.omega << " s; docs/reference.md, \"Internal damping\")";
+      out.push_back(s.str());
+      continue;
+    }
+    if (!(u[kSnapJump] > 0)) continue;
     if (!WatchesRinging(t, set->timestep) && at.bounce_end >= 0) {
       // The bounce watch (BounceMode): the segment mode is damped, the body's bounce is not.
       const BounceMode& b = at.bounce[at.bounce_end];
@@ -3005,7 +3075,7 @@ std::vector<std::string> RingWarnings(const mjModel* m, const mjData* d) {
         << u[kSnapTime] << " s (largest axial wave tension jump " << u[kSnapJump]
         << " N), and body '" << (body ? body : "?") << "' at end " << "AB"[at.bounce_end]
         << " bouncing on the taut line (the line a spring EA/L on the body's effective mass "
-        << c.m_eff << " kg: omega = " << b.omega << " rad/s, omega h = " << b.omega_h
+        << c.m_eff << " kg and a third of the line's, " << b.mass << " kg: omega = " << b.omega << " rad/s, omega h = " << b.omega_h
         << " at <option timestep> " << set->timestep << " s) has damping ratio " << b.ratio
         << " (the segment mode's: " << t.SegmentModeRatio() << "): the step "
         << (IsExplicit(t.params().integrator) ? "keeps the bounce with an energy error"

@@ -711,8 +711,9 @@ struct Run {
   bool held_warning = false;    // Attach warned of a held end force at omega h >= 0.1
   bool lead_warning = false;    // ... or of explicit's consistent coupling at omega h 0.1-1
   std::string ring_warning;     // RingWarnings at the end: a snap rang the undamped segment mode
-  // RingWarnings' other message (session 45): a snap rang the vehicle's bounce on the taut line
-  // (BounceMode), whose cure is the step, not damping_ratio=1: counted, judged by no twin.
+  // RingWarnings' other messages (session 45): a snap rang the vehicle's bounce on the taut line
+  // (BounceMode), or that bounce swung by kSwingRatio x its mean tension without a watched
+  // snap; the cure is the step, not damping_ratio=1: counted, judged by no twin.
   std::string bounce_warning;
   double duration = kDuration;  // [s] simulated
   double deployed = 0;  // [m] a winch's deployed unstretched length at the end (0: no winch)
@@ -908,6 +909,7 @@ struct Outcome {
   // counted, and judged by the damped twin only where the run disagrees.
   bool rang = false;
   bool bounced = false;  // ... that a snap rang the vehicle's bounce (Run::bounce_warning)
+  bool swung = false;    // ... that the vehicle's bounce swung (the same, without a snap)
 };
 
 // The omega h at which the advisor refuses the scene's integrator (0: no limit).
@@ -1392,6 +1394,7 @@ thread_local bool t_stalled = false;
 thread_local bool t_held = false;
 thread_local bool t_rang = false;
 thread_local bool t_bounced = false;
+thread_local bool t_swung = false;
 
 // The twin of a warned run (the scene with the warned cause taken away: Cleared, Damped),
 // judged like any scene at 2 ms for `duration`: it agrees where it passes and its own run gives
@@ -1436,7 +1439,8 @@ Outcome JudgeRuns(const Scene& s) {
   t_stalled = coarse.stalled > 0;
   t_held = coarse.held_warning;
   t_rang = !coarse.ring_warning.empty();
-  t_bounced = !coarse.bounce_warning.empty();
+  t_swung = Contains(coarse.bounce_warning, "swung by");
+  t_bounced = !coarse.bounce_warning.empty() && !t_swung;
   if (!coarse.loaded) return CheckRefusal(s, coarse.error);
   if (const std::string expected = ExpectedRefusal(s); !expected.empty()) {
     return {"not refused", false, "expected a refusal: " + expected};
@@ -1678,13 +1682,14 @@ Outcome JudgeRuns(const Scene& s) {
 }
 
 Outcome Judge(const Scene& s) {
-  t_shortened = t_stalled = t_held = t_rang = t_bounced = false;
+  t_shortened = t_stalled = t_held = t_rang = t_bounced = t_swung = false;
   Outcome o = JudgeRuns(s);
   o.shortened = t_shortened;
   o.stalled = t_stalled;
   o.held = t_held;
   o.rang = t_rang;
   o.bounced = t_bounced;
+  o.swung = t_swung;
   return o;
 }
 
@@ -1754,7 +1759,8 @@ void RunScenes(const std::vector<SceneId>& list, const std::set<SceneId>& known,
            << Describe(s) << "]: " << (o.pass ? "pass" : "FAIL") << ": " << o.kind << ": "
            << o.detail << (o.held ? " [warned at load: held end force]" : "")
            << (o.rang ? " [warned at run: a snap rang the segment mode]" : "")
-           << (o.bounced ? " [warned at run: a snap rang the vehicle's bounce]" : "");
+           << (o.bounced ? " [warned at run: a snap rang the vehicle's bounce]" : "")
+           << (o.swung ? " [warned at run: the vehicle's bounce swung]" : "");
       std::lock_guard<std::mutex> lock(mutex);
       ++counts[(o.pass ? "pass  " : "FAIL  ") + o.kind];
       if (o.shortened) ++counts["(of these, run shortened below 1 s by the cost budget)"];
@@ -1770,6 +1776,10 @@ void RunScenes(const std::vector<SceneId>& list, const std::set<SceneId>& known,
       if (o.bounced) {
         ++counts[o.pass ? "(of these, passes warned of a snap ringing the vehicle's bounce)"
                         : "(of these, failures warned of a snap ringing the vehicle's bounce)"];
+      }
+      if (o.swung) {
+        ++counts[o.pass ? "(of these, passes warned of the vehicle's bounce swinging)"
+                        : "(of these, failures warned of the vehicle's bounce swinging)"];
       }
       const bool is_known = known.count(list[i]) > 0;
       if (!o.pass && is_known) known_failures.push_back(line.str());

@@ -287,7 +287,7 @@ TEST(StepCheck, AVehicleBouncingOnAStiffDampedLineIsWarnedAndTheStepIsTheCure) {
   const Output info = Cli("info " + model);
   ASSERT_EQ(info.status, 0) << info.text;
   EXPECT_NE(info.text.find("damping ratio 0.0002"), std::string::npos) << info.text;
-  EXPECT_NE(info.text.find("(snaps watched"), std::string::npos) << info.text;
+  EXPECT_NE(info.text.find("(snaps and swings watched)"), std::string::npos) << info.text;
   const auto mean_at = [&](const std::string& h, std::string* text) {
     const std::string log = dir + "/b" + h + ".csv";
     const Output run = Cli("run " + model + " --duration 1 --every " + h +
@@ -340,6 +340,43 @@ TEST(StepCheck, AVehicleBouncingOnAStiffDampedLineIsWarnedAndTheStepIsTheCure) {
   const double m0 = WindowMean(l0, l0.Column("t.tension_B"), 1 - kWindow, 1 + 1e-9);
   EXPECT_GT(std::abs(m2 - m0), TensionTolerance(m2, m0))
       << "damping_ratio=1: " << m2 << " N at 2 ms, " << m0 << " N at 0.02 ms";
+}
+
+// A bounce that swings without a snap (scene fuzzer seed 1920 at its span; session 45): the
+// run warns that the tension at the vehicle swung by more than its mean (kSwingRatio) while the
+// step damps the bounce, and the 2 ms run is indeed off the 0.02 ms reference. The watch stops
+// at kBounceOmegaH: at 0.2 ms (omega h 0.016) the run is not warned and is still off (21.7
+// against 32.7 N; the bounce's numerical damping is first order in the step, and the slow-mode
+// correction does not take it where end node B outweighs the body). That is a known silent
+// failure, asserted here so that a change that cures it, or moves it, is seen.
+TEST(StepCheck, AVehicleBounceThatSwingsWithoutASnapIsWarnedAtTheCoarseStep) {
+  const std::string dir = TempDir();
+  const std::string model = kDir + "/bounce_swing.xml";
+  double mean[3];
+  std::string text[3];
+  const char* steps[3] = {"0.002", "0.0002", "0.00002"};
+  for (int k = 0; k < 3; ++k) {
+    const std::string log = dir + "/s" + steps[k] + ".csv";
+    const Output run = Cli("run " + model + " --duration 1 --every " + steps[k] +
+                           " --set option.timestep=" + steps[k] + " --log " + log);
+    ASSERT_EQ(run.status, 0) << run.text;
+    text[k] = run.text;
+    const Log l = ReadLog(log);
+    const int col = l.Column("t.tension_B");
+    ASSERT_GE(col, 0);
+    mean[k] = WindowMean(l, col, 1 - kWindow, 1 + 1e-9);
+    ASSERT_TRUE(std::isfinite(mean[k])) << steps[k];
+  }
+  EXPECT_EQ(text[0].find("snapped taut"), std::string::npos) << text[0];
+  const size_t warned = text[0].find("swung by");
+  ASSERT_NE(warned, std::string::npos) << text[0];
+  EXPECT_NE(text[0].find("compare with a smaller <option timestep>", warned), std::string::npos)
+      << text[0];
+  EXPECT_GT(std::abs(mean[0] - mean[2]), TensionTolerance(mean[0], mean[2]))
+      << mean[0] << " N at 2 ms, " << mean[2] << " N at 0.02 ms";
+  EXPECT_EQ(text[1].find("swung by"), std::string::npos) << text[1];
+  EXPECT_GT(std::abs(mean[1] - mean[2]), TensionTolerance(mean[1], mean[2]))
+      << mean[1] << " N at 0.2 ms, " << mean[2] << " N at 0.02 ms";
 }
 
 // A run that stops: the check says whether the smaller step cures it, and is right both ways
