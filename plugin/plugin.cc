@@ -3031,6 +3031,30 @@ std::vector<std::string> StepWarnings(const mjModel* m) {
   return out;
 }
 
+namespace {
+// RingWarnings' words for body `end`'s bounce on the taut line (BounceMode): what it is, with
+// its figures at the step of Attach, and what the integrator's step does to it.
+std::string BounceWords(const mjModel* m, const ModelTethers& set, const AttachedTether& at,
+                        int end) {
+  const BounceMode& b = at.bounce[end];
+  const CouplingLimit& c = at.limit[end];
+  const char* body = mj_id2name(m, mjOBJ_BODY, c.body);
+  std::ostringstream s;
+  s << "body '" << (body ? body : "?") << "' at end " << "AB"[end]
+    << " bouncing on the taut line (the line a spring EA/L on the body's effective mass "
+    << c.m_eff << " kg and a third of the line's, " << b.mass << " kg: omega = " << b.omega
+    << " rad/s, omega h = " << b.omega_h << " at <option timestep> " << set.timestep
+    << " s, damping ratio " << b.ratio << ")";
+  return s.str();
+}
+
+const char* BounceStepWords(const Tether& t, const BounceMode& b) {
+  return IsExplicit(t.params().integrator) ? "keeps that bounce with an energy error"
+         : b.omega_h > 1                   ? "does not resolve that bounce and damps it"
+                                           : "damps that bounce numerically";
+}
+}  // namespace
+
 std::vector<std::string> RingWarnings(const mjModel* m, const mjData* d) {
   std::vector<std::string> out;
   const ModelTethers* set = Lookup(m);
@@ -3041,51 +3065,42 @@ std::vector<std::string> RingWarnings(const mjModel* m, const mjData* d) {
     std::ostringstream s;
     if (!(u[kSnapJump] > 0) && at.swing_end >= 0 && u[kSwingBest] >= kSwingRatio) {
       // The swing watch (WatchSwing): a bounce that did not snap, or whose snaps were not watched.
-      const BounceMode& b = at.bounce[at.swing_end];
-      const CouplingLimit& c = at.limit[at.swing_end];
-      const char* body = mj_id2name(m, mjOBJ_BODY, c.body);
       s << set->source << ": tether '" << at.name << "': the tension at end "
         << "AB"[at.swing_end] << " swung by " << u[kSwingBest]
-        << " times its mean within two periods of body '" << (body ? body : "?")
-        << "' bouncing on the taut line (from t = " << u[kSwingTime]
-        << " s; the line a spring EA/L on the body's effective mass " << c.m_eff
-        << " kg and a third of the line's, " << b.mass << " kg: omega = " << b.omega << " rad/s, omega h = " << b.omega_h
-        << " at <option timestep> " << set->timestep << " s, damping ratio " << b.ratio
-        << "): the step "
-        << (IsExplicit(t.params().integrator) ? "keeps that bounce with an energy error"
-            : b.omega_h > 1                   ? "does not resolve that bounce and damps it"
-                                              : "damps that bounce numerically")
+        << " times its mean within two bounce periods from t = " << u[kSwingTime] << " s, "
+        << BounceWords(m, *set, at, at.swing_end) << ": the step "
+        << BounceStepWords(t, at.bounce[at.swing_end])
         << ", and a swing that large moves the mean tension (quadratic drag, the line's "
            "geometry, slack), so the tensions may depend on the step (a 12 kg vehicle on one "
            "taut segment, bounce omega h 0.16: 3.5 N at 2 ms, 21.7 N at 0.2 ms, 32.7 N at "
            "0.02 ms; of the scene fuzzer's runs so warned with lines started as long as their "
            "span, 3 in 130 were off their 10x smaller step): compare with a smaller <option "
            "timestep> (the bounce's period is "
-        << 2 * M_PI / b.omega << " s; docs/reference.md, \"Internal damping\")";
+        << 2 * M_PI / at.bounce[at.swing_end].omega
+        << " s; docs/reference.md, \"Internal damping\")";
       out.push_back(s.str());
       continue;
     }
     if (!(u[kSnapJump] > 0)) continue;
     if (!WatchesRinging(t, set->timestep) && at.bounce_end >= 0) {
       // The bounce watch (BounceMode): the segment mode is damped, the body's bounce is not.
-      const BounceMode& b = at.bounce[at.bounce_end];
-      const CouplingLimit& c = at.limit[at.bounce_end];
-      const char* body = mj_id2name(m, mjOBJ_BODY, c.body);
       s << set->source << ": tether '" << at.name << "': a slack segment snapped taut at t = "
-        << u[kSnapTime] << " s (largest axial wave tension jump " << u[kSnapJump]
-        << " N), and body '" << (body ? body : "?") << "' at end " << "AB"[at.bounce_end]
-        << " bouncing on the taut line (the line a spring EA/L on the body's effective mass "
-        << c.m_eff << " kg and a third of the line's, " << b.mass << " kg: omega = " << b.omega << " rad/s, omega h = " << b.omega_h
-        << " at <option timestep> " << set->timestep << " s) has damping ratio " << b.ratio
-        << " (the segment mode's: " << t.SegmentModeRatio() << "): the step "
-        << (IsExplicit(t.params().integrator) ? "keeps the bounce with an energy error"
-            : b.omega_h > 1                   ? "does not resolve that bounce and damps it"
-                                              : "damps that bounce numerically")
+        << u[kSnapTime] << " s (largest axial wave tension jump " << u[kSnapJump] << " N), and "
+        << BounceWords(m, *set, at, at.bounce_end);
+      if (t.SegmentModeRatio() >= kRingDampingRatio) {
+        s << " is damped far less than the segment mode (damping ratio "
+          << t.SegmentModeRatio() << ")";
+      } else {  // the segment mode not watched: resolved by the step (kRingOmegaH)
+        s << " rings, where the segment mode is resolved by the step";
+      }
+      s << ": the step "
+        << BounceStepWords(t, at.bounce[at.bounce_end])
         << ", so the tensions after the snap depend on the step (a 166 kg vehicle on a 2.2 m "
            "line in a 3 m/s current, bounce omega h 0.86: 1490 N at 2 ms, 1811 N at 0.2 ms, "
            "1892 N at 0.02 ms). More line damping does not reach the bounce; compare with a "
            "smaller <option timestep> (the bounce's period is "
-        << 2 * M_PI / b.omega << " s; docs/reference.md, \"Internal damping\")";
+        << 2 * M_PI / at.bounce[at.bounce_end].omega
+        << " s; docs/reference.md, \"Internal damping\")";
       out.push_back(s.str());
       continue;
     }
