@@ -2315,14 +2315,14 @@ bool AdviseCoupling(const mjModel* m, ModelTethers* set, std::string* error) {
       bounce.omega = std::sqrt(p.EA / p.length / bounce.mass);
       bounce.omega_h = bounce.omega * h;
       bounce.ratio = t.EndDamping() / t.segments() / (2 * bounce.mass * bounce.omega);
-      bounce.watched = !at.winch && !WatchesRinging(t, h) && bounce.ratio < kRingDampingRatio &&
-                       bounce.omega_h >= kBounceOmegaH;
+      bounce.swing_watched = !at.winch && bounce.ratio < kRingDampingRatio &&
+                             bounce.omega_h >= kBounceOmegaH;
+      // Its snaps only where the segment mode's are not watched (RingWarnings' first message).
+      bounce.watched = bounce.swing_watched && !WatchesRinging(t, h);
       if (bounce.watched &&
           (at.bounce_end < 0 || bounce.omega_h > at.bounce[at.bounce_end].omega_h)) {
         at.bounce_end = end;
       }
-      bounce.swing_watched = !at.winch && bounce.ratio < kRingDampingRatio &&
-                             bounce.omega_h >= kBounceOmegaH;
       if (bounce.swing_watched &&
           (at.swing_end < 0 || bounce.omega_h > at.bounce[at.swing_end].omega_h)) {
         at.swing_end = end;
@@ -3048,6 +3048,14 @@ std::string BounceWords(const mjModel* m, const ModelTethers& set, const Attache
   return s.str();
 }
 
+// ... and the cure both messages end with.
+std::string BounceCureWords(const BounceMode& b) {
+  std::ostringstream s;
+  s << "compare with a smaller <option timestep> (the bounce's period is " << 2 * M_PI / b.omega
+    << " s; docs/reference.md, \"Internal damping\")";
+  return s.str();
+}
+
 const char* BounceStepWords(const Tether& t, const BounceMode& b) {
   return IsExplicit(t.params().integrator) ? "keeps that bounce with an energy error"
          : b.omega_h > 1                   ? "does not resolve that bounce and damps it"
@@ -3074,10 +3082,8 @@ std::vector<std::string> RingWarnings(const mjModel* m, const mjData* d) {
            "geometry, slack), so the tensions may depend on the step (a 12 kg vehicle on one "
            "taut segment, bounce omega h 0.16: 3.5 N at 2 ms, 21.7 N at 0.2 ms, 32.7 N at "
            "0.02 ms; of the scene fuzzer's runs so warned with lines started as long as their "
-           "span, 3 in 130 were off their 10x smaller step): compare with a smaller <option "
-           "timestep> (the bounce's period is "
-        << 2 * M_PI / at.bounce[at.swing_end].omega
-        << " s; docs/reference.md, \"Internal damping\")";
+           "span, 3 in 130 were off their 10x smaller step): "
+        << BounceCureWords(at.bounce[at.swing_end]);
       out.push_back(s.str());
       continue;
     }
@@ -3097,10 +3103,8 @@ std::vector<std::string> RingWarnings(const mjModel* m, const mjData* d) {
         << BounceStepWords(t, at.bounce[at.bounce_end])
         << ", so the tensions after the snap depend on the step (a 166 kg vehicle on a 2.2 m "
            "line in a 3 m/s current, bounce omega h 0.86: 1490 N at 2 ms, 1811 N at 0.2 ms, "
-           "1892 N at 0.02 ms). More line damping does not reach the bounce; compare with a "
-           "smaller <option timestep> (the bounce's period is "
-        << 2 * M_PI / at.bounce[at.bounce_end].omega
-        << " s; docs/reference.md, \"Internal damping\")";
+           "1892 N at 0.02 ms). More line damping does not reach the bounce; "
+        << BounceCureWords(at.bounce[at.bounce_end]);
       out.push_back(s.str());
       continue;
     }
