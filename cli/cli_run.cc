@@ -518,7 +518,7 @@ int Info(const std::string& path, const std::vector<std::string>& set) {
       std::cout << "\n";
       // The body bouncing on the whole taut line (BounceMode, RingWarnings' bounce watch).
       const mjtether::BounceMode b = mjtether::GetBounceMode(m, k, end);
-      std::cout << "      body bounce on the taut line: omega = sqrt(EA/(L (m_eff + mu L/3))) = "
+      std::cout << "      body bounce on the whole line: omega = sqrt(EA/(L (m_eff + mu L/3))) = "
                 << b.omega
                 << " rad/s, omega h = " << b.omega_h << ", damping ratio " << b.ratio
                 << (b.watched         ? " (snaps and swings watched)"

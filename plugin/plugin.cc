@@ -59,8 +59,21 @@ enum Slot : int {
   kSwingCount,  // [-] ... the steps in it (0: no block yet)
   kSwingBest,   // [-] the largest (max - min)/mean of a closed block
   kSwingTime,   // [s] the start of that block
-  kHeldMeanA,  // [N] (3) implicit2: end A's held force (HeldMean) minus the force at the
-               // state of the last advance, so that calls between advances give the same
+  kAlternationSeen,  // [-] WatchAlternation: end tensions seen, up to 2 (a second difference
+                     // needs three)
+  kAlternationPrev,  // [N] (4) the last two tensions at end A, then at end B: T_{k-1}, T_{k-2}
+  kAlternationD2 = kAlternationPrev + 4,    // [N] (2) per end, the sum of |T_k - 2 T_{k-1} +
+                                            // T_{k-2}| over the current block ...
+  kAlternationSum = kAlternationD2 + 2,     // [N] (2) ... and of T_k
+  kAlternationCount = kAlternationSum + 2,  // [-] the steps in that block
+  kAlternationStart,                        // [s] d->time at its start
+  kAlternationRun,  // [-] (2) per end, the closed blocks in a row up to now that alternated
+  kAlternationSince = kAlternationRun + 2,   // [s] (2) the start of the first of them
+  kAlternationPeak = kAlternationSince + 2,  // [-] (2) their largest ratio
+  kAlternationMean = kAlternationPeak + 2,   // [N] (2) the last one's mean tension
+  kHeldMeanA = kAlternationMean + 2,  // [N] (3) implicit2: end A's held force (HeldMean) minus
+                                      // the force at the state of the last advance, so that
+                                      // calls between advances give the same
   kHeldMeanB = kHeldMeanA + 3,      // [N] (3) the same for end B where it is held
   kHeldPrevA = kHeldMeanB + 3,      // [N] (3) end A's stage mean over the advance before
   kHeldPrevB = kHeldPrevA + 3,      // [N] (3) the same for end B
@@ -587,10 +600,58 @@ void WatchSwing(const AttachedTether& at, double time, double* u) {
   u[kSwingCount] = 1;
 }
 
+// The alternation watch (session 46; plugin/mjtether.h, kAlternationRatio): each end's tension
+// over blocks of kAlternationBlock advances, the mean of its second difference |T_k - 2 T_{k-1} +
+// T_{k-2}| against its mean. Called before each advance, with the last advance's tensions.
+// Implicit schemes only: they damp every mode the step does not resolve, so a tension that
+// alternates at the step's own period is theirs; explicit and rk4 keep an undamped segment
+// mode at their substeps, and its ringing sampled once per step alternates too (the ringing
+// watch's case: at 2 ms, 56 of the 64 scenes of the fuzzer's 2,284 that alternated to their
+// end, none of them off its fine step).
+void WatchAlternation(const Tether& t, double time, double* u) {
+  if (IsExplicit(t.params().integrator) || !(time > u[kStartTime])) return;
+  const double T[2] = {u[kTensionA], u[kTensionB]};  // [N]
+  if (u[kAlternationSeen] >= 2) {
+    if (u[kAlternationCount] == 0) u[kAlternationStart] = time;
+    for (int e = 0; e < 2; ++e) {
+      const double* prev = u + kAlternationPrev + 2 * e;
+      u[kAlternationD2 + e] += std::abs(T[e] - 2 * prev[0] + prev[1]);
+      u[kAlternationSum + e] += T[e];
+    }
+    if (++u[kAlternationCount] >= kAlternationBlock) {
+      for (int e = 0; e < 2; ++e) {
+        const double d2 = u[kAlternationD2 + e] / u[kAlternationCount];     // [N]
+        const double mean = u[kAlternationSum + e] / u[kAlternationCount];  // [N]
+        const double ratio = mean > 0 && d2 >= kRingJump ? d2 / mean : 0;
+        if (ratio >= kAlternationRatio) {
+          if (u[kAlternationRun + e] == 0) {
+            u[kAlternationSince + e] = u[kAlternationStart];
+            u[kAlternationPeak + e] = 0;
+          }
+          u[kAlternationRun + e] += 1;
+          u[kAlternationPeak + e] = std::max(u[kAlternationPeak + e], ratio);
+          u[kAlternationMean + e] = mean;
+        } else {
+          u[kAlternationRun + e] = 0;
+        }
+        u[kAlternationD2 + e] = u[kAlternationSum + e] = 0;
+      }
+      u[kAlternationCount] = 0;
+    }
+  } else {
+    u[kAlternationSeen] += 1;
+  }
+  for (int e = 0; e < 2; ++e) {
+    u[kAlternationPrev + 2 * e + 1] = u[kAlternationPrev + 2 * e];
+    u[kAlternationPrev + 2 * e] = T[e];
+  }
+}
+
 void WatchSnaps(const AttachedTether& at, const double* x, const double* v, double dt,
                 double time, double* u) {
   const Tether& t = at.tether;
   WatchSwing(at, time, u);
+  WatchAlternation(t, time, u);
   if (at.bounce_end < 0 && !WatchesRinging(t, dt)) return;
   const double jump = t.SnapJump(x, v, dt);
   // A snap of kRingBigJump counts; a smaller one where it is kRingRelative of the smaller of
@@ -3040,8 +3101,9 @@ std::string BounceWords(const mjModel* m, const ModelTethers& set, const Attache
   const CouplingLimit& c = at.limit[end];
   const char* body = mj_id2name(m, mjOBJ_BODY, c.body);
   std::ostringstream s;
-  s << "body '" << (body ? body : "?") << "' at end " << "AB"[end]
-    << " bouncing on the taut line (the line a spring EA/L on the body's effective mass "
+  s << "body '" << (body ? body : "?") << "' at end "
+    << "AB"[end]
+    << " bouncing on the whole line (the line a spring EA/L on the body's effective mass "
     << c.m_eff << " kg and a third of the line's, " << b.mass << " kg: omega = " << b.omega
     << " rad/s, omega h = " << b.omega_h << " at <option timestep> " << set.timestep
     << " s, damping ratio " << b.ratio << ")";
@@ -3070,6 +3132,30 @@ std::vector<std::string> RingWarnings(const mjModel* m, const mjData* d) {
   for (const AttachedTether& at : set->tethers) {
     const double* u = d->userdata + at.offset;
     const Tether& t = at.tether;
+    // The end that has alternated longest up to now, over kAlternationBlocks or more.
+    const int e = u[kAlternationRun + 1] >= u[kAlternationRun] ? 1 : 0;
+    if (u[kAlternationRun + e] >= kAlternationBlocks) {
+      // The alternation watch (WatchAlternation): independent of the snaps and swings below.
+      std::ostringstream c;
+      c << set->source << ": tether '" << at.name << "': the tension at end " << "AB"[e]
+        << " has alternated from step to step since t = " << u[kAlternationSince + e]
+        << " s to t = " << d->time << " s (" << u[kAlternationRun + e] << " blocks of "
+        << kAlternationBlock << " steps in a row whose second difference averaged at least "
+        << kAlternationRatio << ", up to " << u[kAlternationPeak + e]
+        << ", times their mean tension; " << u[kAlternationMean + e]
+        << " N in the last): an oscillation at the step's own period that no step resolves, so "
+           "the tensions there are the scheme's, not the line's";
+      if (t.StepsAsBackwardEuler()) {
+        c << " (this line's segment mode is overdamped, damping ratio " << t.SegmentModeRatio()
+          << ", and steps as backward Euler: its stiff damping makes the tension follow the "
+             "nodes' velocities closely)";
+      }
+      c << "; such chatter comes and goes with the step (a bdf2 line stepping as backward "
+           "Euler read 5.0 N at 1 ms, 4.0 N at 2, 0.5 and 0.02 ms): compare with a smaller "
+           "<option timestep> (this run's is "
+        << set->timestep << " s)";
+      out.push_back(c.str());
+    }
     std::ostringstream s;
     if (!(u[kSnapJump] > 0) && at.swing_end >= 0 && u[kSwingBest] >= kSwingRatio) {
       // The swing watch (WatchSwing): a bounce that did not snap, or whose snaps were not watched.

@@ -67,6 +67,8 @@
 // MJTETHER_SCENE_FUZZ_SLACK=x (every scene's tether as long as its span times 1 + x, as
 // Unstretched makes it for x = 0: the draw's lengths, 0.5-3 x the span, seldom start a line
 // near taut; a measurement, not a CI setting: docs/scene_fuzzer.md, session 43).
+// MJTETHER_SCENE_FUZZ_STEP=h (every scene at the MuJoCo step h instead of 2 ms, its references
+// at h/10 and h/100; a measurement, not a CI setting: docs/scene_fuzzer.md, session 46).
 //
 // A second test runs the world draw (MakeWorld: the same scenes with a tether touching a geom
 // or paid out by a winch) through the same oracle: MJTETHER_SCENE_FUZZ_WORLD_COUNT (default
@@ -96,7 +98,23 @@
 namespace mjtether {
 namespace {
 
-constexpr double kStep = 0.002;    // [s] MuJoCo step of the scene
+// [s] MuJoCo step the scenes run at: 2 ms, or MJTETHER_SCENE_FUZZ_STEP (0 < h <= 2 ms), a
+// measurement of the oracle at a user's smaller step (docs/scene_fuzzer.md, session 46). The
+// references follow it (h/10, h/100); the draw does not (kDrawStep), so a seed is the same
+// scene at every step.
+double FuzzStep() {
+  const char* v = std::getenv("MJTETHER_SCENE_FUZZ_STEP");
+  if (!v || !*v) return 0.002;
+  char* end = nullptr;
+  const double h = std::strtod(v, &end);
+  if (*end || !(h > 0 && h <= 0.002)) {
+    std::fprintf(stderr, "MJTETHER_SCENE_FUZZ_STEP=%s: a step in (0, 0.002] s\n", v);
+    std::exit(2);
+  }
+  return h;
+}
+const double kStep = FuzzStep();
+constexpr double kDrawStep = 0.002;  // [s] the step the draw's limits are set for
 constexpr double kDuration = 1.0;  // [s] simulated
 constexpr double kThrustStart = 0.1;  // [s] the thrust ramps from 0 then to s.thrust at 0.4 s
 constexpr double kAverage = 0.2;   // [s] tension averaged over the last kAverage
@@ -557,7 +575,7 @@ Scene MakeWorld(unsigned long long seed) {
   s.max_speed = LogUniform(r, 0.2, 5);
   // 0.999: the plugin compares max_speed x timestep with a quarter of L0 as the MJCF's 10
   // digits give them.
-  if (Chance(r, 0.85)) s.max_speed = std::min(s.max_speed, 0.999 * 0.25 * s.L0() / kStep);
+  if (Chance(r, 0.85)) s.max_speed = std::min(s.max_speed, 0.999 * 0.25 * s.L0() / kDrawStep);
   s.max_accel = LogUniform(r, 0.2, 10);
   s.tau = Uniform(r, 0, 0.5);
   const double speed = (Chance(r, 0.5) ? 1 : -1) * Uniform(r, 0.1, 3);
@@ -715,6 +733,9 @@ struct Run {
   // (BounceMode), or that bounce swung by kSwingRatio x its mean tension without a watched
   // snap; the cure is the step, not damping_ratio=1: counted, judged by no twin.
   std::string bounce_warning;
+  // RingWarnings' alternation watch (session 46, kAlternationRatio): an end tension that
+  // alternates from step to step; counted, judged by no twin.
+  std::string alternation_warning;
   double duration = kDuration;  // [s] simulated
   double deployed = 0;  // [m] a winch's deployed unstretched length at the end (0: no winch)
   // Energy balance of the tether (scenes without current, see EnergyExcess): the largest
@@ -872,9 +893,12 @@ Run Simulate(const Scene& s, double step, double duration = -1) {
   run.warnings = t_warnings;
   if (t_warnings > 0) run.message = t_last_warning;
   run.stalled = static_cast<int>(StallWarnings(m, d).size());
-  if (const std::vector<std::string> ring = RingWarnings(m, d); !ring.empty()) {
-    (Contains(ring.front(), "bouncing on the taut line") ? run.bounce_warning : run.ring_warning) =
-        ring.front();
+  for (const std::string& w : RingWarnings(m, d)) {
+    if (Contains(w, "alternated from step to step")) {
+      run.alternation_warning = w;
+    } else if (run.bounce_warning.empty() && run.ring_warning.empty()) {
+      (Contains(w, "bouncing on the whole line") ? run.bounce_warning : run.ring_warning) = w;
+    }
   }
   run.tension = count > 0 ? sum / count : 0;
   const int rov = mj_name2id(m, mjOBJ_BODY, "rov"), tms = mj_name2id(m, mjOBJ_BODY, "tms");
@@ -910,6 +934,7 @@ struct Outcome {
   bool rang = false;
   bool bounced = false;  // ... that a snap rang the vehicle's bounce (Run::bounce_warning)
   bool swung = false;    // ... that the vehicle's bounce swung (the same, without a snap)
+  bool alternated = false;  // ... that an end tension alternated from step to step
 };
 
 // The omega h at which the advisor refuses the scene's integrator (0: no limit).
@@ -1029,7 +1054,7 @@ Scene Unstretched(const Scene& s, double slack = 0) {
     // twin's shorter segments (a quarter segment per step) as MakeWorld cuts it.
     u.min_length = std::max(u.L0(), std::min(s.min_length, u.length));
     u.max_length = std::max(s.max_length, u.length);
-    u.max_speed = std::min(s.max_speed, 0.999 * 0.25 * u.L0() / kStep);
+    u.max_speed = std::min(s.max_speed, 0.999 * 0.25 * u.L0() / kDrawStep);
     u.xml.replace(u.xml.find(WinchText(s)), WinchText(s).size(), WinchText(u));
   }
   return u;
@@ -1395,6 +1420,7 @@ thread_local bool t_held = false;
 thread_local bool t_rang = false;
 thread_local bool t_bounced = false;
 thread_local bool t_swung = false;
+thread_local bool t_alternated = false;
 
 // The twin of a warned run (the scene with the warned cause taken away: Cleared, Damped),
 // judged like any scene at 2 ms for `duration`: it agrees where it passes and its own run gives
@@ -1441,6 +1467,7 @@ Outcome JudgeRuns(const Scene& s) {
   t_rang = !coarse.ring_warning.empty();
   t_swung = Contains(coarse.bounce_warning, "swung by");
   t_bounced = !coarse.bounce_warning.empty() && !t_swung;
+  t_alternated = !coarse.alternation_warning.empty();
   if (!coarse.loaded) return CheckRefusal(s, coarse.error);
   if (const std::string expected = ExpectedRefusal(s); !expected.empty()) {
     return {"not refused", false, "expected a refusal: " + expected};
@@ -1682,7 +1709,7 @@ Outcome JudgeRuns(const Scene& s) {
 }
 
 Outcome Judge(const Scene& s) {
-  t_shortened = t_stalled = t_held = t_rang = t_bounced = t_swung = false;
+  t_shortened = t_stalled = t_held = t_rang = t_bounced = t_swung = t_alternated = false;
   Outcome o = JudgeRuns(s);
   o.shortened = t_shortened;
   o.stalled = t_stalled;
@@ -1690,6 +1717,7 @@ Outcome Judge(const Scene& s) {
   o.rang = t_rang;
   o.bounced = t_bounced;
   o.swung = t_swung;
+  o.alternated = t_alternated;
   return o;
 }
 
@@ -1760,7 +1788,8 @@ void RunScenes(const std::vector<SceneId>& list, const std::set<SceneId>& known,
            << o.detail << (o.held ? " [warned at load: held end force]" : "")
            << (o.rang ? " [warned at run: a snap rang the segment mode]" : "")
            << (o.bounced ? " [warned at run: a snap rang the vehicle's bounce]" : "")
-           << (o.swung ? " [warned at run: the vehicle's bounce swung]" : "");
+           << (o.swung ? " [warned at run: the vehicle's bounce swung]" : "")
+           << (o.alternated ? " [warned at run: an end tension alternated]" : "");
       std::lock_guard<std::mutex> lock(mutex);
       ++counts[(o.pass ? "pass  " : "FAIL  ") + o.kind];
       if (o.shortened) ++counts["(of these, run shortened below 1 s by the cost budget)"];
@@ -1780,6 +1809,10 @@ void RunScenes(const std::vector<SceneId>& list, const std::set<SceneId>& known,
       if (o.swung) {
         ++counts[o.pass ? "(of these, passes warned of the vehicle's bounce swinging)"
                         : "(of these, failures warned of the vehicle's bounce swinging)"];
+      }
+      if (o.alternated) {
+        ++counts[o.pass ? "(of these, passes warned of an end tension alternating)"
+                        : "(of these, failures warned of an end tension alternating)"];
       }
       const bool is_known = known.count(list[i]) > 0;
       if (!o.pass && is_known) known_failures.push_back(line.str());
