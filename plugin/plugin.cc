@@ -3101,8 +3101,7 @@ std::string BounceWords(const mjModel* m, const ModelTethers& set, const Attache
   const CouplingLimit& c = at.limit[end];
   const char* body = mj_id2name(m, mjOBJ_BODY, c.body);
   std::ostringstream s;
-  s << "body '" << (body ? body : "?") << "' at end "
-    << "AB"[end]
+  s << "body '" << (body ? body : "?") << "' at end " << "AB"[end]
     << " bouncing on the whole line (the line a spring EA/L on the body's effective mass "
     << c.m_eff << " kg and a third of the line's, " << b.mass << " kg: omega = " << b.omega
     << " rad/s, omega h = " << b.omega_h << " at <option timestep> " << set.timestep

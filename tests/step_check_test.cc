@@ -212,6 +212,20 @@ double WindowMean(const Log& log, int col, double from, double to) {
   return n ? sum / n : NAN;
 }
 
+// `model` run for 1 s at the step h (also its sampling), logged to `log`: the mean vehicle-end
+// tension t.tension_B over the last kWindow (NaN without that column); the run's output in
+// *text where given. The run must exit 0.
+double MeanTensionBAt(const std::string& model, const std::string& h, const std::string& log,
+                      std::string* text) {
+  const Output run = Cli("run " + model + " --duration 1 --every " + h +
+                         " --set option.timestep=" + h + " --log " + log);
+  EXPECT_EQ(run.status, 0) << run.text;
+  if (text) *text = run.text;
+  const Log l = ReadLog(log);
+  const int col = l.Column("t.tension_B");
+  return col < 0 ? NAN : WindowMean(l, col, 1 - kWindow, 1 + 1e-9);
+}
+
 // A run warning that asks for the comparison (a snap that rang the undamped segment mode, at the
 // run's end) is followed by the note that points to --check-step, once; a checked run has none.
 // The scene is a line started as long as its span (scene fuzzer seed 491 at
@@ -289,14 +303,7 @@ TEST(StepCheck, AVehicleBouncingOnAStiffDampedLineIsWarnedAndTheStepIsTheCure) {
   EXPECT_NE(info.text.find("damping ratio 0.0002"), std::string::npos) << info.text;
   EXPECT_NE(info.text.find("(snaps and swings watched)"), std::string::npos) << info.text;
   const auto mean_at = [&](const std::string& h, std::string* text) {
-    const std::string log = dir + "/b" + h + ".csv";
-    const Output run = Cli("run " + model + " --duration 1 --every " + h +
-                           " --set option.timestep=" + h + " --log " + log);
-    EXPECT_EQ(run.status, 0) << run.text;
-    if (text) *text = run.text;
-    const Log l = ReadLog(log);
-    const int col = l.Column("t.tension_B");
-    return col < 0 ? NAN : WindowMean(l, col, 1 - kWindow, 1 + 1e-9);
+    return MeanTensionBAt(model, h, dir + "/b" + h + ".csv", text);
   };
   std::string coarse_text, fine_text;
   const double coarse = mean_at("0.002", &coarse_text);
@@ -450,14 +457,7 @@ TEST(StepCheck, AnEndTensionThatAlternatesFromStepToStepIsWarned) {
   for (const Case& c : cases) {
     const std::string model = kDir + "/" + c.scene;
     const auto run = [&](const std::string& h, std::string* text) {
-      const std::string log = dir + "/" + c.scene + h + ".csv";
-      const Output o = Cli("run " + model + " --duration 1 --every " + h +
-                           " --set option.timestep=" + h + " --log " + log);
-      EXPECT_EQ(o.status, 0) << o.text;
-      *text = o.text;
-      const Log l = ReadLog(log);
-      const int col = l.Column("t.tension_B");
-      return col < 0 ? NAN : WindowMean(l, col, 1 - kWindow, 1 + 1e-9);
+      return MeanTensionBAt(model, h, dir + "/" + c.scene + h + ".csv", text);
     };
     std::string text;
     const double reference = run("0.0001", &text);
